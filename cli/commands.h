@@ -1,0 +1,18 @@
+// Subcommands of the `solidtex` executable. Each parses its own arguments, does its work
+// through synth/, prints its result, and returns a Status; main() reports errors once.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "status.h"
+
+namespace solidtex::cli {
+
+Status run_analyze(const std::vector<std::string>& args);
+Status run_exemplar(const std::vector<std::string>& args);
+
+// Applies --threads (0 = all cores) for the rest of the process.
+void set_thread_limit(int threads);
+
+}  // namespace solidtex::cli

@@ -1,0 +1,55 @@
+// The solidtex executable: one binary, several subcommands. Errors are reported here, once.
+#include <tbb/global_control.h>
+
+#include <exception>
+#include <iostream>
+#include <memory>
+
+#include "commands.h"
+
+namespace solidtex::cli {
+
+namespace {
+std::unique_ptr<tbb::global_control> g_threads;
+}
+
+void set_thread_limit(int threads) {
+  if (threads > 0) g_threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, size_t(threads));
+}
+
+}  // namespace solidtex::cli
+
+namespace {
+
+constexpr const char* kUsage =
+    "usage: solidtex <command> [options]\n"
+    "commands:\n"
+    "  analyze IMAGE [--yz IMAGE --zx IMAGE] [--mask IMAGE] [--levels 4] [--neighborhood 9]\n"
+    "          [--candidates 12] [--pca-dims 20] [--seed S] [--threads T] -o TABLE.stx [--json]\n"
+    "  exemplar KIND -o FILE.png [--size W,H] [--seed S]     KIND: wood, stripes, bricks, noise\n";
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace solidtex;
+  if (argc < 2 || std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h") {
+    std::cout << kUsage;
+    return argc < 2 ? 2 : 0;
+  }
+  const std::string command = argv[1];
+  const std::vector<std::string> args(argv + 2, argv + argc);
+  try {
+    Status st;
+    if (command == "analyze") st = cli::run_analyze(args);
+    else if (command == "exemplar") st = cli::run_exemplar(args);
+    else st = Status(StatusCode::kInvalidArgument, "unknown command '" + command + "'\n" + kUsage, "command");
+    if (!st.is_ok()) {
+      std::cerr << "solidtex " << command << ": error: " << st.to_string() << "\n";
+      return st.code() == StatusCode::kInvalidArgument ? 2 : 1;
+    }
+    return 0;
+  } catch (const std::exception& e) {
+    std::cerr << "solidtex " << command << ": internal error: " << e.what() << "\n";
+    return 1;
+  }
+}
