@@ -82,21 +82,23 @@ CoordinateTriple rotate_planes(const CoordinateTriple& t, int k) {
 
 double crossbar_error(const PlaneStacks& stacks, const CoordinateTriple& t, int n, int spacing) {
   const int c = stacks[0]->channels;
-  std::vector<float> a(size_t(n) * c), b(size_t(n) * c);
+  float a[16 * 4], b[16 * 4];  // n <= 15, channels <= 4
   double total = 0;
   for (int k = 0; k < 3; ++k) {
-    gather_line(*stacks[k], t.at[k], LineAxis::kSecond, n, spacing, a.data());
-    gather_line(*stacks[(k + 1) % 3], t.at[(k + 1) % 3], LineAxis::kFirst, n, spacing, b.data());
-    total += sq_dist(a.data(), b.data(), n * c);
+    gather_line(*stacks[k], t.at[k], LineAxis::kSecond, n, spacing, a);
+    gather_line(*stacks[(k + 1) % 3], t.at[(k + 1) % 3], LineAxis::kFirst, n, spacing, b);
+    total += sq_dist(a, b, n * c);
   }
   return total / (3.0 * n * c);
 }
 
 void measure_level_candidates(const PlaneStacks& stacks, int n, int spacing, uint32_t seed, LevelCandidates& level) {
   // Per-row partial sums, added in row order: the figure does not depend on thread count.
+  // With one image for all planes, planes yz and zx are rotations of xy with equal errors.
+  const bool shared = stacks[0] == stacks[1] && stacks[1] == stacks[2];
   double sum = 0;
   int64_t count = 0;
-  for (int k = 0; k < 3; ++k) {
+  for (int k = 0; k < (shared ? 1 : 3); ++k) {
     const PlaneCandidates& pc = level.planes[k];
     std::vector<double> row_sum(size_t(pc.height), 0.0);
     tbb::parallel_for(tbb::blocked_range<int>(0, pc.height), [&](const tbb::blocked_range<int>& rows) {
