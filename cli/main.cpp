@@ -26,6 +26,9 @@ constexpr const char* kUsage =
     "commands:\n"
     "  analyze IMAGE [--yz IMAGE --zx IMAGE] [--mask IMAGE] [--levels 4] [--neighborhood 9]\n"
     "          [--candidates 12] [--pca-dims 20] [--seed S] [--threads T] -o TABLE.stx [--json]\n"
+    "  slice TABLE.stx (--axis x|y|z --at K [--origin U,V] | --plane OX,OY,OZ,UX,UY,UZ,VX,VY,VZ)\n"
+    "          --size W,H [--scheme standard|subpass|grid|dual-grid] [--field identity|quat:W,X,Y,Z|FILE]\n"
+    "          [--seed S] [--threads T] -o OUT.png [--stats STATS.json]\n"
     "  exemplar KIND -o FILE.png [--size W,H] [--seed S]     KIND: wood, stripes, bricks, noise\n";
 
 }  // namespace
@@ -42,6 +45,7 @@ int main(int argc, char** argv) {
     Status st;
     if (command == "analyze") st = cli::run_analyze(args);
     else if (command == "exemplar") st = cli::run_exemplar(args);
+    else if (command == "slice") st = cli::run_slice(args);
     else st = Status(StatusCode::kInvalidArgument, "unknown command '" + command + "'\n" + kUsage, "command");
     if (!st.is_ok()) {
       std::cerr << "solidtex " << command << ": error: " << st.to_string() << "\n";

@@ -1,0 +1,53 @@
+// Sparse voxel sets for dependency analysis: 8^3-voxel bit bricks, allocated on first use,
+// indexed by a dense brick table over a fixed bounding box. Insert/contains are O(1) with no
+// hashing; iteration is in a fixed (brick, then bit) order, so anything derived from a mask
+// is deterministic. Not thread-safe for writes.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "types.h"
+
+namespace solidtex {
+
+// Half-open voxel box [lo, hi).
+struct VoxelBox {
+  Voxel lo{0, 0, 0};
+  Voxel hi{0, 0, 0};
+  bool empty() const { return hi.x <= lo.x || hi.y <= lo.y || hi.z <= lo.z; }
+  bool contains(const Voxel& p) const {
+    return p.x >= lo.x && p.y >= lo.y && p.z >= lo.z && p.x < hi.x && p.y < hi.y && p.z < hi.z;
+  }
+  VoxelBox dilated(int r) const { return {{lo.x - r, lo.y - r, lo.z - r}, {hi.x + r, hi.y + r, hi.z + r}}; }
+  void include(const Voxel& p);
+  int64_t volume() const { return empty() ? 0 : int64_t(hi.x - lo.x) * (hi.y - lo.y) * (hi.z - lo.z); }
+};
+
+inline int floor_div(int a, int b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
+
+class VoxelMask {
+ public:
+  VoxelMask() = default;
+  explicit VoxelMask(const VoxelBox& box);
+
+  const VoxelBox& box() const { return box_; }
+  // Returns true when p was not yet in the set. p must lie inside box().
+  bool insert(const Voxel& p);
+  bool contains(const Voxel& p) const;
+  int64_t count() const { return count_; }
+  std::vector<Voxel> to_vector() const;
+
+ private:
+  int brick_index(const Voxel& p) const {
+    return ((floor_div(p.z, 8) - b0_[2]) * bn_[1] + (floor_div(p.y, 8) - b0_[1])) * bn_[0] + (floor_div(p.x, 8) - b0_[0]);
+  }
+  VoxelBox box_;
+  std::array<int, 3> b0_{}, bn_{};
+  std::vector<int32_t> table_;                 // brick -> index into bricks_, or -1
+  std::vector<std::array<uint64_t, 8>> bricks_;  // 512 bits: bit (x + 8y + 64z)
+  int64_t count_ = 0;
+};
+
+}  // namespace solidtex
