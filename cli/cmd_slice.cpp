@@ -11,6 +11,7 @@
 #include "commands.h"
 #include "image_io.h"
 #include "progress_bar.h"
+#include "quality.h"
 #include "synthesizer.h"
 #include "table_file.h"
 
@@ -56,8 +57,8 @@ Result<TargetSet> parse_cut(const Args& args) {
 
 Status run_slice(const std::vector<std::string>& argv) {
   Args args({"-o", "--axis", "--at", "--origin", "--plane", "--size", "--scheme", "--field", "--seed", "--threads",
-             "--stats", "--passes", "--coarse-passes", "--cell", "--cache-mb"},
-            {});
+             "--stats", "--passes", "--coarse-passes", "--cell", "--cache-mb", "--plane-weights"},
+            {"--energy"});
   SOLIDTEX_RETURN_IF_ERROR(args.parse(argv));
   if (args.positionals().size() != 1)
     return Status(StatusCode::kInvalidArgument, "expects exactly one TABLE.stx", "table");
@@ -72,11 +73,16 @@ Status run_slice(const std::vector<std::string>& argv) {
   SOLIDTEX_ASSIGN_OR_RETURN(params.passes, args.get_int("--passes", params.passes, 0, 8));
   SOLIDTEX_ASSIGN_OR_RETURN(params.coarse_passes, args.get_int("--coarse-passes", params.coarse_passes, 0, 8));
   SOLIDTEX_ASSIGN_OR_RETURN(params.cell_size, args.get_int("--cell", params.cell_size, 4, 64));
+  SOLIDTEX_ASSIGN_OR_RETURN(auto table, load_table(args.positionals()[0]));
+  params.plane_weights = table->params().suggested_plane_weights;
+  if (args.has("--plane-weights")) {
+    SOLIDTEX_ASSIGN_OR_RETURN(auto w, args.get_list("--plane-weights", 3));
+    params.plane_weights = {float(w[0]), float(w[1]), float(w[2])};
+  }
   SOLIDTEX_RETURN_IF_ERROR(params.validate());
   SOLIDTEX_ASSIGN_OR_RETURN(int threads, args.get_int("--threads", 0, 0, 1024));
   set_thread_limit(threads);
   SOLIDTEX_ASSIGN_OR_RETURN(int cache_mb, args.get_int("--cache-mb", 256, 0, 1 << 20));
-  SOLIDTEX_ASSIGN_OR_RETURN(auto table, load_table(args.positionals()[0]));
   SOLIDTEX_ASSIGN_OR_RETURN(auto field, parse_field_spec(args.get("--field").value_or("identity")));
   SOLIDTEX_ASSIGN_OR_RETURN(auto synth, Synthesizer::create(table, field, params, int64_t(cache_mb) << 20));
   ProgressBar bar;
@@ -89,6 +95,11 @@ Status run_slice(const std::vector<std::string>& argv) {
   nlohmann::json j = stats_json(stats);
   j["scheme"] = scheme_name(params.scheme);
   j["field"] = field->describe();
+  if (args.has("--energy")) {
+    // Neighbourhood-matching energy of the cut against exemplar xy (quality.h).
+    j["energy"] = neighbourhood_energy(img, table->exemplars().plane(Plane::kXY), table->params().neighborhood, 2);
+    std::cerr << "energy " << j["energy"] << "\n";
+  }
   if (auto path = args.get("--stats")) {
     const std::string text = j.dump(2) + "\n";
     SOLIDTEX_RETURN_IF_ERROR(write_file_atomic(*path, std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(text.data()), text.size())));

@@ -29,7 +29,7 @@ constexpr const char* kUsage =
     "  slice TABLE.stx (--axis x|y|z --at K [--origin U,V] | --plane OX,OY,OZ,UX,UY,UZ,VX,VY,VZ)\n"
     "          --size W,H [--scheme standard|subpass|grid|dual-grid] [--field identity|quat:W,X,Y,Z|FILE]\n"
     "          [--seed S] [--threads T] -o OUT.png [--stats STATS.json]\n"
-    "  exemplar KIND -o FILE.png [--size W,H] [--seed S]     KIND: wood, stripes, bricks, noise\n";
+    "  exemplar KIND -o FILE.png [--size W,H] [--seed S]     KIND: wood, stripes, bricks, noise, spots\n";
 
 }  // namespace
 

@@ -22,6 +22,13 @@ Status AnalysisParams::validate() const {
   SOLIDTEX_RETURN_IF_ERROR(range(pca_dims, 1, 64, "pca_dims"));
   SOLIDTEX_RETURN_IF_ERROR(range(search_k, candidates / 2 + 1, 64, "search_k"));
   SOLIDTEX_RETURN_IF_ERROR(range(knn_checks, 16, 100000, "knn_checks"));
+  float total = 0.f;
+  for (float w : suggested_plane_weights) {
+    if (!(w >= 0.f && w <= 1.f))
+      return Status(StatusCode::kInvalidArgument, "each must be in [0, 1]", "suggested_plane_weights");
+    total += w;
+  }
+  if (!(total > 0.f)) return Status(StatusCode::kInvalidArgument, "must not all be zero", "suggested_plane_weights");
   return Status::ok();
 }
 

@@ -72,24 +72,31 @@ void stencil_offsets(const ReadStencil& s, std::vector<std::array<int8_t, 3>>& o
   out.erase(std::unique(out.begin(), out.end()), out.end());
 }
 
-void matching_colour(const TableLevel& level, const CoordinateTriple& t, int channels, float* out) {
+PlaneWeights normalised_weights(const std::array<float, 3>& w) {
+  const float total = w[0] + w[1] + w[2];
+  return {w[0] / total, w[1] / total, w[2] / total};
+}
+
+void matching_colour(const TableLevel& level, const CoordinateTriple& t, int channels, const PlaneWeights& w, float* out) {
   const float* a = level.planes[0]->stack.wrapped(t.at[0].x, t.at[0].y);
   const float* b = level.planes[1]->stack.wrapped(t.at[1].x, t.at[1].y);
   const float* c = level.planes[2]->stack.wrapped(t.at[2].x, t.at[2].y);
-  for (int k = 0; k < channels; ++k) out[k] = (a[k] + b[k] + c[k]) * (1.f / 3.f);
+  for (int k = 0; k < channels; ++k) out[k] = w[0] * a[k] + w[1] * b[k] + w[2] * c[k];
   for (int k = channels; k < 4; ++k) out[k] = 0.f;
 }
 
-void output_colour(const Table& table, const CoordinateTriple& t, float rgb[3]) {
+void output_colour(const Table& table, const CoordinateTriple& t, const PlaneWeights& w, float rgb[3]) {
   const ExemplarSet& e = table.exemplars();
   const float* a = e.plane(Plane::kXY).wrapped(t.at[0].x, t.at[0].y);
   const float* b = e.plane(Plane::kYZ).wrapped(t.at[1].x, t.at[1].y);
   const float* c = e.plane(Plane::kZX).wrapped(t.at[2].x, t.at[2].y);
-  for (int k = 0; k < 3; ++k) rgb[k] = (a[k] + b[k] + c[k]) * (1.f / 3.f);
+  for (int k = 0; k < 3; ++k) rgb[k] = w[0] * a[k] + w[1] * b[k] + w[2] * c[k];
 }
 
-CorrectionContext CorrectionContext::make(const Table& table, PyramidLevel l) {
+CorrectionContext CorrectionContext::make(const Table& table, PyramidLevel l, const std::array<float, 3>& plane_weights) {
   CorrectionContext ctx;
+  ctx.cost_weights = plane_weights;
+  ctx.colour_weights = normalised_weights(plane_weights);
   ctx.level = &table.level(l);
   ctx.n = table.params().neighborhood;
   ctx.spacing = table.spacing(l);
@@ -189,7 +196,7 @@ CoordinateTriple best_candidate(const CorrectionContext& ctx, const CoordinateTr
         const float diff = q[r] - a[r];
         acc[0] += diff * diff;
       }
-      cost += (acc[0] + acc[1]) + (acc[2] + acc[3]);
+      cost += ctx.cost_weights[size_t(k)] * ((acc[0] + acc[1]) + (acc[2] + acc[3]));
     }
     if (cost < best || (cost == best && t < best_t)) {
       best = cost;

@@ -19,8 +19,8 @@
 // go to the lexicographically smallest triple. No randomness, fixed summation order.
 //
 // Voxel colour: the matching colour of a triple is the mean over the three planes of that
-// level's Gaussian-stack colour at T_k (RGB plus mask channel); the output colour of a
-// finest-level voxel is the same mean over the original exemplars' linear RGB.
+// level's Gaussian-stack colour at T_k (RGB plus mask channel), weighted by the plane weights;
+// the output colour of a finest-level voxel is the same mean over the original exemplars' RGB.
 #pragma once
 
 #include <array>
@@ -57,8 +57,11 @@ void build_stencil(const Rot3& r, int n, bool trilinear, ReadStencil& out);
 // Every distinct voxel offset the stencil reads, in a fixed order.
 void stencil_offsets(const ReadStencil& s, std::vector<std::array<int8_t, 3>>& out);
 
-void matching_colour(const TableLevel& level, const CoordinateTriple& t, int channels, float* out);
-void output_colour(const Table& table, const CoordinateTriple& t, float rgb[3]);
+// Colours are weighted means over the planes (weights normalised to sum to 1).
+using PlaneWeights = std::array<float, 3>;
+PlaneWeights normalised_weights(const std::array<float, 3>& w);
+void matching_colour(const TableLevel& level, const CoordinateTriple& t, int channels, const PlaneWeights& w, float* out);
+void output_colour(const Table& table, const CoordinateTriple& t, const PlaneWeights& w, float rgb[3]);
 
 // Per-level constants of the correction, precomputed once per synthesizer.
 struct CorrectionContext {
@@ -69,7 +72,9 @@ struct CorrectionContext {
   int dims = 0;                                      // PCA output dims per plane
   std::array<std::vector<float>, 3> basis_t;         // input-major PCA bases
   std::array<const float*, 3> mean{};
-  static CorrectionContext make(const Table& table, PyramidLevel l);
+  PlaneWeights cost_weights{1.f, 1.f, 1.f};          // per-plane matching weights
+  PlaneWeights colour_weights{1.f / 3, 1.f / 3, 1.f / 3};
+  static CorrectionContext make(const Table& table, PyramidLevel l, const std::array<float, 3>& plane_weights);
 };
 
 struct CorrectionScratch {

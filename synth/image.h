@@ -30,6 +30,9 @@ struct ImageF {
   friend bool operator==(const ImageF&, const ImageF&) = default;
 };
 
+// Swaps the axes: out(x, y) = in(y, x).
+ImageF transposed(const ImageF& in);
+
 // sRGB transfer curve, per channel value in [0, 1].
 float srgb_to_linear(float v);
 float linear_to_srgb(float v);

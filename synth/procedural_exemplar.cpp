@@ -92,16 +92,36 @@ void noise(float u, float v, uint32_t seed, float* rgb) {
   rgb[0] = a; rgb[1] = 0.5f * (a + b); rgb[2] = b;
 }
 
+// Dark blobs on a light, slightly noisy ground (leopard-like): one jittered disc per cell of
+// a periodic 5x5 lattice, radius varying per cell.
+void spots(float u, float v, uint32_t seed, float* rgb) {
+  const int cells = 5;
+  float best = 1e9f;
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx) {
+      const int cx = int(std::floor(u * cells)) + dx, cy = int(std::floor(v * cells)) + dy;
+      const uint32_t h = hash3(uint32_t(((cx % cells) + cells) % cells), uint32_t(((cy % cells) + cells) % cells), seed);
+      const float px = (cx + 0.2f + 0.6f * unit(h)) / cells, py = (cy + 0.2f + 0.6f * unit(h * 2654435761u)) / cells;
+      const float r = (0.22f + 0.12f * unit(h ^ 0x5bd1e995u)) / cells;
+      best = std::min(best, std::hypot(u - px, v - py) / r);
+    }
+  const float grit = fbm(u, v, 16, 16, seed + 9) - 0.5f;
+  const float ground[3] = {0.85f + 0.1f * grit, 0.62f + 0.1f * grit, 0.35f + 0.08f * grit};
+  const float dark[3] = {0.08f, 0.06f, 0.05f};
+  lerp_rgb(dark, ground, std::clamp((best - 0.85f) * 6.f, 0.f, 1.f), rgb);
+}
+
 }  // namespace
 
-std::vector<std::string> procedural_kind_names() { return {"wood", "stripes", "bricks", "noise"}; }
+std::vector<std::string> procedural_kind_names() { return {"wood", "stripes", "bricks", "noise", "spots"}; }
 
 Result<ProceduralKind> parse_procedural_kind(const std::string& name) {
   if (name == "wood") return ProceduralKind::kWood;
   if (name == "stripes") return ProceduralKind::kStripes;
   if (name == "bricks") return ProceduralKind::kBricks;
   if (name == "noise") return ProceduralKind::kNoise;
-  return Status(StatusCode::kInvalidArgument, "unknown kind '" + name + "' (wood, stripes, bricks, noise)", "kind");
+  if (name == "spots") return ProceduralKind::kSpots;
+  return Status(StatusCode::kInvalidArgument, "unknown kind '" + name + "' (wood, stripes, bricks, noise, spots)", "kind");
 }
 
 Result<ImageF> make_procedural_exemplar(const ProceduralParams& p) {
@@ -117,6 +137,7 @@ Result<ImageF> make_procedural_exemplar(const ProceduralParams& p) {
         case ProceduralKind::kStripes: stripes(u, v, p.seed, srgb); break;
         case ProceduralKind::kBricks: bricks(u, v, p.seed, srgb); break;
         case ProceduralKind::kNoise: noise(u, v, p.seed, srgb); break;
+        case ProceduralKind::kSpots: spots(u, v, p.seed, srgb); break;
       }
       float* out = img.at(x, y);
       for (int c = 0; c < 3; ++c) out[c] = srgb_to_linear(std::clamp(srgb[c], 0.f, 1.f));

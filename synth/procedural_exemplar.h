@@ -10,7 +10,7 @@
 
 namespace solidtex {
 
-enum class ProceduralKind { kWood, kStripes, kBricks, kNoise };
+enum class ProceduralKind { kWood, kStripes, kBricks, kNoise, kSpots };
 
 struct ProceduralParams {
   ProceduralKind kind = ProceduralKind::kWood;

@@ -35,6 +35,12 @@ Status SynthesisParams::validate() const {
   SOLIDTEX_RETURN_IF_ERROR(range(init_subpart, 8, 256, "init_subpart"));
   if (init_subpart % 2) return Status(StatusCode::kInvalidArgument, "must be even", "init_subpart");
   SOLIDTEX_RETURN_IF_ERROR(range(trilinear_levels, 0, 8, "trilinear_levels"));
+  float total = 0.f;
+  for (float w : plane_weights) {
+    if (!(w >= 0.f && w <= 1.f)) return Status(StatusCode::kInvalidArgument, "each must be in [0, 1]", "plane_weights");
+    total += w;
+  }
+  if (!(total > 0.f)) return Status(StatusCode::kInvalidArgument, "must not all be zero", "plane_weights");
   return Status::ok();
 }
 

@@ -3,6 +3,7 @@
 // finer level 2 passes of dual-grid correction (cell M = 12) with s^3 = 8 subpasses.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <string>
 
@@ -30,6 +31,10 @@ struct SynthesisParams {
   int init_subpart = 32;     // K: coarsest-level voxels per initialisation subpart side, even, [8, 256]
   int trilinear_levels = 2;  // the coarsest this-many levels sample neighbourhoods trilinearly, [0, 8]
   uint32_t seed = 1;         // hashed with (voxel, level) wherever synthesis needs randomness
+  // Relative weight of each plane (xy, yz, zx) in matching costs and voxel colours, [0, 1],
+  // not all zero. Zhang §6.1: a plane whose exemplar conflicts with the others in 3D (e.g.
+  // the end grain of a wood exemplar) is best given a small weight.
+  std::array<float, 3> plane_weights{1.f, 1.f, 1.f};
 
   Status validate() const;
 };

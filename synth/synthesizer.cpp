@@ -78,7 +78,7 @@ Result<std::shared_ptr<Synthesizer>> Synthesizer::create(std::shared_ptr<const T
   if (s->impl_->constant_field) s->impl_->constant_rotation = Rot3::from_quat(s->field_->at({0, 0, 0}));
   for (int l = 0; l < L; ++l) {
     s->schedules_.push_back(LevelSchedule::make(l, params));
-    s->impl_->contexts.push_back(CorrectionContext::make(*s->table_, PyramidLevel{l}));
+    s->impl_->contexts.push_back(CorrectionContext::make(*s->table_, PyramidLevel{l}, params.plane_weights));
     const bool trilinear = l < params.trilinear_levels;
     s->impl_->reach.push_back(base_reach + 1);
     ReadStencil st;
@@ -148,7 +148,7 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize(const TargetSe
         store.allocate(p);
         VoxelState& s = store.at(p, sch.slot(p, V));
         s.triple = cached[i];
-        matching_colour(*impl.contexts[size_t(l)].level, s.triple, channels, s.colour.data());
+        matching_colour(*impl.contexts[size_t(l)].level, s.triple, channels, impl.contexts[size_t(l)].colour_weights, s.colour.data());
         store.set_flag(p, sch.slot(p, V), LevelStore::kRequired);
         cache_hits[size_t(l)].push_back(p);
       } else {
@@ -242,7 +242,7 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize(const TargetSe
           }
           s.triple = upsample_triple(table, PyramidLevel{l}, p, parent_store->at(P, pslot).triple, rotation(l - 1, P));
         }
-        matching_colour(*ctx.level, s.triple, channels, s.colour.data());
+        matching_colour(*ctx.level, s.triple, channels, ctx.colour_weights, s.colour.data());
       }
     });
     if (l > 0) {
@@ -285,7 +285,7 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize(const TargetSe
           };
           VoxelState& out = store.at(p, sch.slot(p, v));
           out.triple = correct_voxel(ctx, *st, read, scratch);
-          matching_colour(*ctx.level, out.triple, channels, out.colour.data());
+          matching_colour(*ctx.level, out.triple, channels, ctx.colour_weights, out.colour.data());
         }
       });
     }
@@ -311,7 +311,7 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize(const TargetSe
     const Voxel& p = target.voxels[i];
     const int slot = fsch.slot(p, fsch.final_version());
     if (options.instrument) fstore.set_flag(p, slot, LevelStore::kRead);
-    output_colour(table, fstore.at(p, slot).triple, voxel_rgb[i].data());
+    output_colour(table, fstore.at(p, slot).triple, impl.contexts[size_t(fl)].colour_weights, voxel_rgb[i].data());
   }
   check_tightness(fl);
   std::vector<std::array<float, 3>> out(target.sample.size());

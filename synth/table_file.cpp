@@ -63,6 +63,7 @@ std::vector<uint8_t> encode_table(const Table& table) {
   w.i32(p.search_k);
   w.i32(p.knn_checks);
   w.u32(p.seed);
+  for (float pw : p.suggested_plane_weights) w.f32(pw);
   const bool shared = table.exemplars().shared();
   w.u8(shared ? 1 : 0);
   w.u8(table.exemplars().has_mask() ? 1 : 0);
@@ -131,6 +132,7 @@ Result<std::shared_ptr<const Table>> decode_table(std::span<const uint8_t> bytes
   SOLIDTEX_RETURN_IF_ERROR(r.i32(p.search_k));
   SOLIDTEX_RETURN_IF_ERROR(r.i32(p.knn_checks));
   SOLIDTEX_RETURN_IF_ERROR(r.u32(p.seed));
+  for (float& pw : p.suggested_plane_weights) SOLIDTEX_RETURN_IF_ERROR(r.f32(pw));
   if (Status st = p.validate(); !st) return corrupt("stored parameters are invalid: " + st.to_string());
   uint8_t shared = 0, has_mask = 0;
   SOLIDTEX_RETURN_IF_ERROR(r.u8(shared));
