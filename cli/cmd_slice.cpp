@@ -57,7 +57,7 @@ Result<TargetSet> parse_cut(const Args& args) {
 
 Status run_slice(const std::vector<std::string>& argv) {
   Args args({"-o", "--axis", "--at", "--origin", "--plane", "--size", "--scheme", "--field", "--seed", "--threads",
-             "--stats", "--passes", "--coarse-passes", "--cell", "--cache-mb", "--plane-weights"},
+             "--stats", "--passes", "--coarse-passes", "--cell", "--cache-mb", "--plane-weights", "--matcher"},
             {"--energy"});
   SOLIDTEX_RETURN_IF_ERROR(args.parse(argv));
   if (args.positionals().size() != 1)
@@ -67,6 +67,9 @@ Status run_slice(const std::vector<std::string>& argv) {
   SynthesisParams params;
   if (auto s = args.get("--scheme")) {
     SOLIDTEX_ASSIGN_OR_RETURN(params.scheme, parse_scheme(*s));
+  }
+  if (auto m = args.get("--matcher")) {
+    SOLIDTEX_ASSIGN_OR_RETURN(params.matcher, parse_matcher(*m));
   }
   SOLIDTEX_ASSIGN_OR_RETURN(int seed, args.get_int("--seed", 1, 0, 1 << 30));
   params.seed = uint32_t(seed);
@@ -94,6 +97,7 @@ Status run_slice(const std::vector<std::string>& argv) {
   SOLIDTEX_RETURN_IF_ERROR(save_png_srgb8(out, img));
   nlohmann::json j = stats_json(stats);
   j["scheme"] = scheme_name(params.scheme);
+  j["matcher"] = matcher_name(params.matcher);
   j["field"] = field->describe();
   if (args.has("--energy")) {
     // Neighbourhood-matching energy of the cut against exemplar xy (quality.h).

@@ -93,8 +93,10 @@ void output_colour(const Table& table, const CoordinateTriple& t, const PlaneWei
   for (int k = 0; k < 3; ++k) rgb[k] = w[0] * a[k] + w[1] * b[k] + w[2] * c[k];
 }
 
-CorrectionContext CorrectionContext::make(const Table& table, PyramidLevel l, const std::array<float, 3>& plane_weights) {
+CorrectionContext CorrectionContext::make(const Table& table, PyramidLevel l, const std::array<float, 3>& plane_weights,
+                                          bool coherent_matcher) {
   CorrectionContext ctx;
+  ctx.candidates_per_source = coherent_matcher ? 4 : 64;
   ctx.cost_weights = plane_weights;
   ctx.colour_weights = normalised_weights(plane_weights);
   ctx.level = &table.level(l);
@@ -115,7 +117,25 @@ CorrectionContext CorrectionContext::make(const Table& table, PyramidLevel l, co
 
 namespace detail {
 
-void project_planes(const CorrectionContext& ctx, CorrectionScratch& s) {
+// Squared distance with four fixed accumulator lanes: vectorisable and order-stable.
+__attribute__((target_clones("avx2", "default"))) float plane_distance(const float* q, const float* a, int d) {
+  float acc[4] = {0.f, 0.f, 0.f, 0.f};
+  int r = 0;
+  for (; r + 4 <= d; r += 4)
+    for (int j = 0; j < 4; ++j) {
+      const float diff = q[r + j] - a[r + j];
+      acc[j] += diff * diff;
+    }
+  for (; r < d; ++r) {
+    const float diff = q[r] - a[r];
+    acc[0] += diff * diff;
+  }
+  return (acc[0] + acc[1]) + (acc[2] + acc[3]);
+}
+
+// Lane-wise identical whatever the vector width (no FMA, no reassociation), so the AVX2 and
+// baseline clones give the same bits.
+__attribute__((target_clones("avx2", "default"))) void project_planes(const CorrectionContext& ctx, CorrectionScratch& s) {
   const int in_dims = ctx.n * ctx.n * ctx.channels;
   const int d = ctx.dims;
   s.projected.assign(size_t(3) * d, 0.f);
@@ -134,73 +154,46 @@ void project_planes(const CorrectionContext& ctx, CorrectionScratch& s) {
 
 CoordinateTriple best_candidate(const CorrectionContext& ctx, const CoordinateTriple& current,
                                 const std::array<std::array<ExemplarPixel, 9>, 3>& sources, CorrectionScratch& s) {
-  constexpr size_t kSlots = 1024;
-  if (s.seen.size() != kSlots) {
-    s.seen.assign(kSlots, CoordinateTriple{});
-    s.seen_stamp.assign(kSlots, 0);
-  }
-  if (++s.stamp == 0) {
-    std::fill(s.seen_stamp.begin(), s.seen_stamp.end(), 0);
-    s.stamp = 1;
-  }
+  // Candidates of distinct sources of one plane differ in that plane's coordinate, and one
+  // source's list holds distinct triples, so deduplicating the (at most 9) sources per plane
+  // leaves only cross-plane repeats, which cost a re-evaluation but cannot change the winner.
   const TableLevel& level = *ctx.level;
-  auto canonical = [&](CoordinateTriple t) {
-    for (int k = 0; k < 3; ++k) {
-      const ImageF& img = level.planes[size_t(k)]->stack;
-      t.at[size_t(k)] = {ImageF::wrap(t.at[size_t(k)].x, img.width), ImageF::wrap(t.at[size_t(k)].y, img.height)};
-    }
-    return t;
-  };
-  auto slot_of = [](const CoordinateTriple& t) {
-    const uint64_t a = uint64_t(uint32_t(t.at[0].x)) | uint64_t(uint32_t(t.at[0].y)) << 32;
-    const uint64_t b = uint64_t(uint32_t(t.at[1].x)) | uint64_t(uint32_t(t.at[1].y)) << 32;
-    const uint64_t c = uint64_t(uint32_t(t.at[2].x)) | uint64_t(uint32_t(t.at[2].y)) << 32;
-    return size_t(mix64(a * 0x9e3779b97f4a7c15ull ^ mix64(b ^ mix64(c)))) & (kSlots - 1);
-  };
-  s.candidates.clear();
-  auto add = [&](const CoordinateTriple& t) {
-    size_t slot = slot_of(t);
-    while (s.seen_stamp[slot] == s.stamp) {
-      if (s.seen[slot] == t) return;
-      slot = (slot + 1) & (kSlots - 1);
-    }
-    s.seen_stamp[slot] = s.stamp;
-    s.seen[slot] = t;
-    s.candidates.push_back(t);
-  };
-  add(canonical(current));
-  for (int k = 0; k < 3; ++k) {
-    const PlaneCandidates& pc = level.candidates.planes[size_t(k)];
-    for (const ExemplarPixel& src : sources[size_t(k)])
-      for (const CoordinateTriple& t : pc.at(src)) add(t);
-  }
   const int d = ctx.dims;
   float best = std::numeric_limits<float>::infinity();
-  CoordinateTriple best_t = s.candidates.front();
-  for (const CoordinateTriple& t : s.candidates) {
+  CoordinateTriple best_t{};
+  auto consider = [&](const CoordinateTriple& t) {
     // Planes are summed in a fixed order; a candidate whose partial cost already exceeds the
     // best cannot win (costs only grow), so stopping early changes no result.
     float cost = 0.f;
     for (int k = 0; k < 3 && cost <= best; ++k) {
       const PlaneAppearance& app = *level.planes[size_t(k)];
       const float* a = &app.projected[(size_t(t.at[size_t(k)].y) * app.stack.width + size_t(t.at[size_t(k)].x)) * d];
-      const float* q = s.projected.data() + size_t(k) * d;
-      float acc[4] = {0.f, 0.f, 0.f, 0.f};  // four fixed lanes: vectorisable, order-stable
-      int r = 0;
-      for (; r + 4 <= d; r += 4)
-        for (int j = 0; j < 4; ++j) {
-          const float diff = q[r + j] - a[r + j];
-          acc[j] += diff * diff;
-        }
-      for (; r < d; ++r) {
-        const float diff = q[r] - a[r];
-        acc[0] += diff * diff;
-      }
-      cost += ctx.cost_weights[size_t(k)] * ((acc[0] + acc[1]) + (acc[2] + acc[3]));
+      cost += ctx.cost_weights[size_t(k)] * plane_distance(s.projected.data() + size_t(k) * d, a, d);
     }
     if (cost < best || (cost == best && t < best_t)) {
       best = cost;
       best_t = t;
+    }
+  };
+  CoordinateTriple cur = current;
+  for (int k = 0; k < 3; ++k) {
+    const ImageF& img = level.planes[size_t(k)]->stack;
+    cur.at[size_t(k)] = {ImageF::wrap(cur.at[size_t(k)].x, img.width), ImageF::wrap(cur.at[size_t(k)].y, img.height)};
+  }
+  consider(cur);
+  for (int k = 0; k < 3; ++k) {
+    const PlaneCandidates& pc = level.candidates.planes[size_t(k)];
+    std::array<ExemplarPixel, 9> unique;
+    int count = 0;
+    for (const ExemplarPixel& raw : sources[size_t(k)]) {
+      const ExemplarPixel src{ImageF::wrap(raw.x, pc.width), ImageF::wrap(raw.y, pc.height)};
+      bool seen = false;
+      for (int u = 0; u < count && !seen; ++u) seen = unique[size_t(u)] == src;
+      if (seen) continue;
+      unique[size_t(count++)] = src;
+      const auto list = pc.at(src);
+      const size_t take = std::min(list.size(), size_t(ctx.candidates_per_source));
+      for (size_t c = 0; c < take; ++c) consider(list[c]);
     }
   }
   return best_t;

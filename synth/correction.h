@@ -73,17 +73,15 @@ struct CorrectionContext {
   std::array<std::vector<float>, 3> basis_t;         // input-major PCA bases
   std::array<const float*, 3> mean{};
   PlaneWeights cost_weights{1.f, 1.f, 1.f};          // per-plane matching weights
+  int candidates_per_source = 64;                    // table candidates tried per source pixel
   PlaneWeights colour_weights{1.f / 3, 1.f / 3, 1.f / 3};
-  static CorrectionContext make(const Table& table, PyramidLevel l, const std::array<float, 3>& plane_weights);
+  static CorrectionContext make(const Table& table, PyramidLevel l, const std::array<float, 3>& plane_weights,
+                                bool coherent_matcher);
 };
 
 struct CorrectionScratch {
   std::vector<float> gathered;    // 3 * n*n*channels
   std::vector<float> projected;   // 3 * dims
-  std::vector<CoordinateTriple> candidates;
-  std::vector<CoordinateTriple> seen;  // open-addressing set, valid where seen_stamp == stamp
-  std::vector<uint32_t> seen_stamp;
-  uint32_t stamp = 0;
 };
 
 namespace detail {

@@ -17,11 +17,27 @@ HistoryWindow HistoryWindow::grid(int step_version, CellLattice cells, int barri
 }
 
 HistoryWindow HistoryWindow::intersect(const HistoryWindow& other) const {
+  // resolve() supports up to four barrier components; the schedules use at most one.
   HistoryWindow w;
   w.latest_ = std::min(latest_, other.latest_);
   w.barriers_ = barriers_;
   w.barriers_.insert(w.barriers_.end(), other.barriers_.begin(), other.barriers_.end());
   return w;
+}
+
+HistoryWindow::Resolved HistoryWindow::resolve(const Voxel& p) const {
+  Resolved r;
+  r.latest = latest_;
+  for (const Barrier& b : barriers_) {
+    const int s = b.cells.size;
+    const Voxel lo{b.cells.cell_of(p.x) * s + b.cells.offset, b.cells.cell_of(p.y) * s + b.cells.offset,
+                   b.cells.cell_of(p.z) * s + b.cells.offset};
+    r.lo[size_t(r.count)] = lo;
+    r.hi[size_t(r.count)] = {lo.x + s, lo.y + s, lo.z + s};
+    r.barrier_version[size_t(r.count)] = b.version;
+    ++r.count;
+  }
+  return r;
 }
 
 std::vector<int> HistoryWindow::materialize(const Voxel& p, int d) const {

@@ -17,6 +17,8 @@
 // nothing scheme-specific. Immutable; thread-safe.
 #pragma once
 
+#include <algorithm>
+#include <array>
 #include <vector>
 
 #include "synthesis_params.h"
@@ -50,6 +52,24 @@ class HistoryWindow {
     }
     return v;
   }
+  // The window of one voxel p with its cells resolved to bounds, so that per-neighbour
+  // lookups are comparisons only: version_of(q) == version(p, q - p).
+  struct Resolved {
+    int latest = 0;
+    int count = 0;
+    std::array<int, 4> barrier_version{};
+    std::array<Voxel, 4> lo{}, hi{};  // p's cell, half-open, per barrier (at most 4)
+    int version_of(const Voxel& q) const {
+      int v = latest;
+      for (int b = 0; b < count; ++b)
+        if (q.x < lo[size_t(b)].x || q.y < lo[size_t(b)].y || q.z < lo[size_t(b)].z || q.x >= hi[size_t(b)].x ||
+            q.y >= hi[size_t(b)].y || q.z >= hi[size_t(b)].z)
+          v = std::min(v, barrier_version[size_t(b)]);
+      return v;
+    }
+  };
+  Resolved resolve(const Voxel& p) const;
+
   // The D x D x D window of p as an array (x fastest), offsets -D/2..D/2: for inspection/tests.
   std::vector<int> materialize(const Voxel& p, int d) const;
   bool has_barrier() const { return !barriers_.empty(); }

@@ -10,6 +10,14 @@ Result<Scheme> parse_scheme(const std::string& name) {
   return Status(StatusCode::kInvalidArgument, "unknown scheme '" + name + "' (standard, subpass, grid, dual-grid)", "scheme");
 }
 
+Result<Matcher> parse_matcher(const std::string& name) {
+  if (name == "paper") return Matcher::kPaper;
+  if (name == "coherent") return Matcher::kCoherent;
+  return Status(StatusCode::kInvalidArgument, "unknown matcher '" + name + "' (paper, coherent)", "matcher");
+}
+
+const char* matcher_name(Matcher m) { return m == Matcher::kPaper ? "paper" : "coherent"; }
+
 const char* scheme_name(Scheme s) {
   switch (s) {
     case Scheme::kStandard: return "standard";

@@ -11,6 +11,13 @@
 
 namespace solidtex {
 
+// How many table candidates per source pixel the correction considers (Zhang §4.3 uses all
+// N_T). kCoherent is our shortcut: the first 4 (the best by crossbar error), plus the current
+// triple; it keeps the coherent proposals that dominate the result at a third of the cost.
+enum class Matcher { kPaper, kCoherent };
+Result<Matcher> parse_matcher(const std::string& name);
+const char* matcher_name(Matcher m);
+
 enum class Scheme {
   kStandard,  // P plain passes, every voxel updated per step, no barriers
   kSubpass,   // P passes of s^3 subpasses, no barriers (Lefebvre-Hoppe / Dong et al.)
@@ -24,6 +31,7 @@ const char* scheme_name(Scheme s);
 
 struct SynthesisParams {
   Scheme scheme = Scheme::kDualGrid;
+  Matcher matcher = Matcher::kPaper;
   int coarse_passes = 3;     // plain passes at the coarsest level (never barriered), [0, 8]
   int passes = 2;            // correction passes at every finer level, [0, 8]
   int subpass_size = 2;      // s: s^3 subpasses per pass for subpass/grid schemes, {1, 2}

@@ -78,7 +78,8 @@ Result<std::shared_ptr<Synthesizer>> Synthesizer::create(std::shared_ptr<const T
   if (s->impl_->constant_field) s->impl_->constant_rotation = Rot3::from_quat(s->field_->at({0, 0, 0}));
   for (int l = 0; l < L; ++l) {
     s->schedules_.push_back(LevelSchedule::make(l, params));
-    s->impl_->contexts.push_back(CorrectionContext::make(*s->table_, PyramidLevel{l}, params.plane_weights));
+    s->impl_->contexts.push_back(CorrectionContext::make(*s->table_, PyramidLevel{l}, params.plane_weights,
+                                                              params.matcher == Matcher::kCoherent));
     const bool trilinear = l < params.trilinear_levels;
     s->impl_->reach.push_back(base_reach + 1);
     ReadStencil st;
@@ -163,24 +164,28 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize(const TargetSe
     for (int v = V; v >= 1; --v) {
       if (poller.poll(-1)) return Status(StatusCode::kCancelled, "synthesis cancelled");
       const CorrectionStep& step = sch.steps()[size_t(v - 1)];
+      int64_t updated = 0;
       for (const Voxel& p : m[size_t(v)].to_vector()) {
         if (!step.updates.contains(p)) {
           m[size_t(v - 1)].insert(p);
           continue;
         }
+        ++updated;
         const std::vector<std::array<int8_t, 3>>* offs = &impl.constant_offsets[size_t(l)];
         if (!impl.constant_field) {
           build_stencil(rotation(l, p), n, trilinear, stencil);
           stencil_offsets(stencil, offsets);
           offs = &offsets;
         }
+        const HistoryWindow::Resolved window = step.window.resolve(p);
         for (const auto& o : *offs) {
           const Voxel q = add(p, o);
           if (!box0[size_t(l)].contains(q))
             return Status(StatusCode::kInternal, "dependency escaped its bounding box (stencil reach too small)");
-          m[size_t(step.window.version(p, o[0], o[1], o[2]))].insert(q);
+          m[size_t(window.version_of(q))].insert(q);
         }
       }
+      stats.levels[size_t(l)].corrections += updated;
     }
     stats.levels[size_t(l)].voxels = m[0].count();
     if (l > 0) {
@@ -193,6 +198,19 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize(const TargetSe
     }
   }
   stats.dependency_seconds = since(t_dep);
+  auto finish = [&]() {
+    interrupter.end();
+    for (const LevelStats& ls : stats.levels) {
+      stats.voxels += ls.voxels;
+      stats.corrections += ls.corrections;
+    }
+    stats.seconds = since(t_start);
+  };
+  if (options.dependencies_only) {
+    finish();
+    if (stats_out) *stats_out = std::move(stats);
+    return std::vector<std::array<float, 3>>{};
+  }
 
   // ---- Forward: synthesize inside the sets, coarsest level first. ----
   std::atomic<int64_t> unsound{0};
@@ -252,7 +270,6 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize(const TargetSe
 
     // Correction steps.
     const bool trilinear = l < params_.trilinear_levels;
-    int64_t corrections = 0;
     for (int v = 1; v <= V; ++v) {
       const int percent = int(100.0 * (l + double(v) / (V + 1)) / L);
       if (poller.poll(percent)) return Status(StatusCode::kCancelled, "synthesis cancelled");
@@ -260,7 +277,6 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize(const TargetSe
       std::vector<Voxel> updates;
       for (const Voxel& p : masks[size_t(l)][size_t(v)].to_vector())
         if (step.updates.contains(p)) updates.push_back(p);
-      corrections += int64_t(updates.size());
       tbb::parallel_for(tbb::blocked_range<size_t>(0, updates.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
         CorrectionScratch scratch;
         ReadStencil local;
@@ -271,9 +287,10 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize(const TargetSe
             build_stencil(rotation(l, p), n, trilinear, local);
             st = &local;
           }
+          const HistoryWindow::Resolved window = step.window.resolve(p);
           auto read = [&](int dx, int dy, int dz) -> const VoxelState& {
             const Voxel q{p.x + dx, p.y + dy, p.z + dz};
-            const int slot = sch.slot(q, step.window.version(p, dx, dy, dz));
+            const int slot = sch.slot(q, window.version_of(q));
             if (options.instrument) {
               if (!store.has(q) || !(store.flags(q, slot) & LevelStore::kRequired)) {
                 ++unsound;
@@ -289,7 +306,6 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize(const TargetSe
         }
       });
     }
-    stats.levels[size_t(l)].corrections = corrections;
 
     if (options.use_cache) {
       std::vector<Voxel> finals = masks[size_t(l)][size_t(V)].to_vector();
@@ -317,14 +333,9 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize(const TargetSe
   std::vector<std::array<float, 3>> out(target.sample.size());
   for (size_t i = 0; i < target.sample.size(); ++i) out[i] = voxel_rgb[target.sample[i]];
 
-  interrupter.end();
-  for (const LevelStats& ls : stats.levels) {
-    stats.voxels += ls.voxels;
-    stats.corrections += ls.corrections;
-  }
   stats.unsound_reads = unsound.load();
   stats.unread_required = unread;
-  stats.seconds = since(t_start);
+  finish();
   if (stats_out) *stats_out = std::move(stats);
   return out;
 }

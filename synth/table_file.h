@@ -23,7 +23,7 @@
 
 namespace solidtex {
 
-inline constexpr uint32_t kTableFormatVersion = 1;
+inline constexpr uint32_t kTableFormatVersion = 2;  // 2: suggested plane weights
 
 std::vector<uint8_t> encode_table(const Table& table);
 Result<std::shared_ptr<const Table>> decode_table(std::span<const uint8_t> bytes);

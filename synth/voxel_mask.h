@@ -41,7 +41,7 @@ class VoxelMask {
 
  private:
   int brick_index(const Voxel& p) const {
-    return ((floor_div(p.z, 8) - b0_[2]) * bn_[1] + (floor_div(p.y, 8) - b0_[1])) * bn_[0] + (floor_div(p.x, 8) - b0_[0]);
+    return (((p.z >> 3) - b0_[2]) * bn_[1] + ((p.y >> 3) - b0_[1])) * bn_[0] + ((p.x >> 3) - b0_[0]);  // >> floors (C++20)
   }
   VoxelBox box_;
   std::array<int, 3> b0_{}, bn_{};
