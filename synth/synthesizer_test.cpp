@@ -110,6 +110,20 @@ TEST_F(SynthesizerTest, ThreadsCacheStateAndPiecesDoNotChangeBits) {
   EXPECT_EQ(one, whole);
 }
 
+TEST_F(SynthesizerTest, TinyCacheBudgetEvictsBricksAndKeepsResults) {
+  auto roomy = make(table_, "identity", small_params(), 64 << 20);
+  auto tiny = make(table_, "identity", small_params(), 64 << 10);  // 64 KiB: about ten leaves
+  const auto a1 = cut(*roomy, 'z', 2, 0, 0, 16, 16);
+  const auto b1 = cut(*tiny, 'z', 2, 0, 0, 16, 16);
+  const auto b2 = cut(*tiny, 'z', 2, 0, 0, 16, 16);  // partly re-synthesized after eviction
+  EXPECT_EQ(a1, b1);
+  EXPECT_EQ(a1, b2);
+  const auto c = tiny->cache().counters();
+  EXPECT_GT(c.evicted_bricks, 0);
+  EXPECT_LE(c.bytes, tiny->cache().budget_bytes());
+  EXPECT_GT(roomy->cache().counters().bricks, c.bricks);
+}
+
 TEST_F(SynthesizerTest, PlaneCutsAndPointsMatchAxisCuts) {
   auto s = make(table_, "identity", small_params(), 0);
   const auto axis = cut(*s, 'y', 7, -3, 4, 10, 6);

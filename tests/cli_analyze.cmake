@@ -31,3 +31,23 @@ execute_process(COMMAND ${ST} analyze ${TMP}/bad.png -o ${TMP}/bad.stx RESULT_VA
 if(rc EQUAL 0 OR NOT err MATCHES "not a PNG")
   message(FATAL_ERROR "corrupt image accepted or unclear error: ${rc} ${err}")
 endif()
+# A slice with stats: the JSON names voxels and corrections per level and in total.
+execute_process(COMMAND ${ST} slice ${TMP}/wood.stx --axis z --at 3 --size 12,10 --passes 1 -o ${TMP}/cut.png
+  --stats ${TMP}/cut.json RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "slice failed: ${rc} ${err}")
+endif()
+file(READ ${TMP}/cut.json stats)
+foreach(key voxels corrections seconds corrections_per_second)
+  string(JSON v GET "${stats}" ${key})
+endforeach()
+string(JSON l0 GET "${stats}" levels 0 voxels)
+string(JSON c2 GET "${stats}" levels 2 corrections)
+if(l0 LESS 1 OR c2 LESS 1)
+  message(FATAL_ERROR "implausible stats: ${stats}")
+endif()
+execute_process(COMMAND ${ST} slice ${TMP}/bad.png --axis z --at 0 --size 4,4 -o ${TMP}/x.png
+  RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(rc EQUAL 0 OR NOT err MATCHES "corrupt")
+  message(FATAL_ERROR "a non-table input was accepted or the error is unclear: ${err}")
+endif()
