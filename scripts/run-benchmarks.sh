@@ -1,8 +1,12 @@
 #!/usr/bin/env bash
-# Runs every benchmark in bench/ and prints one JSON document: {"analysis": [...], ...}.
+# Runs every benchmark in bench/ and prints one JSON document: {"analysis": [...], "slice": {...}}.
+# Uses ../shared/data/exemplars/wood_grain.png when present, else a procedural wood exemplar.
 set -euo pipefail
 build=${1:-build}
+quick=${2:-}
 shared=$(cd "$(dirname "$0")/../.." && pwd)/shared
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
 echo '{"analysis": ['
 first=1
 for size in 96 128 256; do
@@ -10,4 +14,13 @@ for size in 96 128 256; do
   first=0
   "$build/bin/bench_analysis" "$size"
 done
-echo ']}'
+echo '],'
+exemplar="$shared/data/exemplars/wood_grain.png"
+if [ ! -f "$exemplar" ]; then
+  "$build/bin/solidtex" exemplar wood --size 96,96 -o "$tmp/wood.png" 2>/dev/null
+  exemplar="$tmp/wood.png"
+fi
+"$build/bin/solidtex" analyze "$exemplar" --grain x -o "$tmp/wood.stx" >/dev/null
+echo '"slice":'
+"$build/bin/bench_slice" "$tmp/wood.stx" $quick
+echo '}'

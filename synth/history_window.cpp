@@ -75,12 +75,12 @@ LevelSchedule LevelSchedule::make(int level, const SynthesisParams& params) {
       s.steps_.push_back(step);
     }
   }
-  s.slot_table_.assign(size_t(classes), std::vector<int>(size_t(version) + 1, 0));
+  s.slot_table_.assign(size_t(classes) * (size_t(version) + 1), 0);
   for (int c = 0; c < classes; ++c) {
     int count = 0;
     for (int v = 1; v <= version; ++v) {
       if (s.steps_[size_t(v - 1)].updates.s == 1 || s.steps_[size_t(v - 1)].updates.index == c) ++count;
-      s.slot_table_[c][v] = count;
+      s.slot_table_[size_t(c) * (size_t(version) + 1) + size_t(v)] = count;
     }
     s.slot_count_ = std::max(s.slot_count_, count + 1);
   }

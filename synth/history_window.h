@@ -107,7 +107,9 @@ class LevelSchedule {
   static LevelSchedule make(int level, const SynthesisParams& params);
   const std::vector<CorrectionStep>& steps() const { return steps_; }
   int final_version() const { return int(steps_.size()); }
-  int slot(const Voxel& p, int version) const { return slot_table_[UpdateClass::class_of(p, s_)][version]; }
+  int slot(const Voxel& p, int version) const {
+    return slot_table_[size_t(UpdateClass::class_of(p, s_) * (final_version() + 1) + version)];
+  }
   int slot_count() const { return slot_count_; }  // max updates of any voxel + 1
   int subpass_size() const { return s_; }
 
@@ -115,7 +117,7 @@ class LevelSchedule {
   std::vector<CorrectionStep> steps_;
   int s_ = 1;
   int slot_count_ = 1;
-  std::vector<std::vector<int>> slot_table_;  // [class][version]
+  std::vector<int> slot_table_;  // [class * (final_version + 1) + version]
 };
 
 }  // namespace solidtex

@@ -5,6 +5,7 @@
 // by the instrumented mode (required / read).
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <memory>
 #include <vector>
@@ -15,6 +16,8 @@
 namespace solidtex {
 
 class LevelStore {
+  struct Brick;
+
  public:
   static constexpr uint8_t kRequired = 1;
   static constexpr uint8_t kRead = 2;
@@ -28,6 +31,30 @@ class LevelStore {
   uint8_t flags(const Voxel& p, int slot) const;
   void set_flag(const Voxel& p, int slot, uint8_t f);  // thread-safe (atomic or)
   int slots() const { return slots_; }
+
+  // The 3x3x3 bricks around voxel p, looked up once, so that reads at offsets up to +-8
+  // cost no table lookups. Missing bricks are null.
+  class Neighbourhood {
+   public:
+    Neighbourhood(const LevelStore& store, const Voxel& p) : p_(p), slots_(store.slots_) {
+      for (int z = -1; z <= 1; ++z)
+        for (int y = -1; y <= 1; ++y)
+          for (int x = -1; x <= 1; ++x) {
+            const Voxel c{p.x + 8 * x, p.y + 8 * y, p.z + 8 * z};
+            near_[size_t((z + 1) * 9 + (y + 1) * 3 + (x + 1))] = store.box_.contains(c) ? store.brick(c) : nullptr;
+          }
+    }
+    const VoxelState& at(int dx, int dy, int dz, int slot) const {
+      const int lx = (p_.x & 7) + dx, ly = (p_.y & 7) + dy, lz = (p_.z & 7) + dz;
+      const Brick* b = near_[size_t(((lz >> 3) + 1) * 9 + ((ly >> 3) + 1) * 3 + ((lx >> 3) + 1))];
+      return b->states[size_t((lx & 7) + 8 * (ly & 7) + 64 * (lz & 7)) * slots_ + slot];
+    }
+
+   private:
+    Voxel p_;
+    int slots_;
+    std::array<const Brick*, 27> near_{};
+  };
   int64_t bytes() const { return int64_t(bricks_.size()) * brick_bytes(); }
   const VoxelBox& box() const { return box_; }
 

@@ -134,7 +134,8 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize(const TargetSe
     const LevelSchedule& sch = schedules_[size_t(l)];
     const int V = sch.final_version();
     auto& m = masks[size_t(l)];
-    m.assign(size_t(V) + 1, VoxelMask(box0[size_t(l)]));
+    m.clear();
+    for (int v = 0; v <= V; ++v) m.emplace_back(box0[size_t(l)]);
     stores[size_t(l)] = std::make_unique<LevelStore>(box0[size_t(l)], sch.slot_count());
     LevelStore& store = *stores[size_t(l)];
     stats.levels[size_t(l)].level = l;
@@ -158,33 +159,44 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize(const TargetSe
     }
     stats.levels[size_t(l)].cache_hits = int64_t(cache_hits[size_t(l)].size());
 
-    ReadStencil stencil;
-    std::vector<std::array<int8_t, 3>> offsets;
     const bool trilinear = l < params_.trilinear_levels;
     for (int v = V; v >= 1; --v) {
       if (poller.poll(-1)) return Status(StatusCode::kCancelled, "synthesis cancelled");
       const CorrectionStep& step = sch.steps()[size_t(v - 1)];
-      int64_t updated = 0;
-      for (const Voxel& p : m[size_t(v)].to_vector()) {
-        if (!step.updates.contains(p)) {
-          m[size_t(v - 1)].insert(p);
-          continue;
+      const std::vector<Voxel> members = m[size_t(v)].to_vector();
+      std::atomic<int64_t> updated{0};
+      std::atomic<bool> escaped{false};
+      // Set union is order-independent, so the parallel inserts give the same sets.
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, members.size(), 512), [&](const tbb::blocked_range<size_t>& r) {
+        ReadStencil stencil;
+        std::vector<std::array<int8_t, 3>> offsets;
+        int64_t local_updates = 0;
+        for (size_t i = r.begin(); i != r.end(); ++i) {
+          const Voxel& p = members[i];
+          if (!step.updates.contains(p)) {
+            m[size_t(v - 1)].insert(p);
+            continue;
+          }
+          ++local_updates;
+          const std::vector<std::array<int8_t, 3>>* offs = &impl.constant_offsets[size_t(l)];
+          if (!impl.constant_field) {
+            build_stencil(rotation(l, p), n, trilinear, stencil);
+            stencil_offsets(stencil, offsets);
+            offs = &offsets;
+          }
+          const HistoryWindow::Resolved window = step.window.resolve(p);
+          for (const auto& o : *offs) {
+            const Voxel q = add(p, o);
+            if (!box0[size_t(l)].contains(q)) {
+              escaped = true;
+              continue;
+            }
+            m[size_t(window.version_of(q))].insert(q);
+          }
         }
-        ++updated;
-        const std::vector<std::array<int8_t, 3>>* offs = &impl.constant_offsets[size_t(l)];
-        if (!impl.constant_field) {
-          build_stencil(rotation(l, p), n, trilinear, stencil);
-          stencil_offsets(stencil, offsets);
-          offs = &offsets;
-        }
-        const HistoryWindow::Resolved window = step.window.resolve(p);
-        for (const auto& o : *offs) {
-          const Voxel q = add(p, o);
-          if (!box0[size_t(l)].contains(q))
-            return Status(StatusCode::kInternal, "dependency escaped its bounding box (stencil reach too small)");
-          m[size_t(window.version_of(q))].insert(q);
-        }
-      }
+        updated += local_updates;
+      });
+      if (escaped) return Status(StatusCode::kInternal, "dependency escaped its bounding box (stencil reach too small)");
       stats.levels[size_t(l)].corrections += updated;
     }
     stats.levels[size_t(l)].voxels = m[0].count();
@@ -288,6 +300,7 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize(const TargetSe
             st = &local;
           }
           const HistoryWindow::Resolved window = step.window.resolve(p);
+          const LevelStore::Neighbourhood near(store, p);
           auto read = [&](int dx, int dy, int dz) -> const VoxelState& {
             const Voxel q{p.x + dx, p.y + dy, p.z + dz};
             const int slot = sch.slot(q, window.version_of(q));
@@ -298,7 +311,7 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize(const TargetSe
               }
               store.set_flag(q, slot, LevelStore::kRead);
             }
-            return store.at(q, slot);
+            return near.at(dx, dy, dz, slot);
           };
           VoxelState& out = store.at(p, sch.slot(p, v));
           out.triple = correct_voxel(ctx, *st, read, scratch);

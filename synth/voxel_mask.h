@@ -1,11 +1,15 @@
 // Sparse voxel sets for dependency analysis: 8^3-voxel bit bricks, allocated on first use,
 // indexed by a dense brick table over a fixed bounding box. Insert/contains are O(1) with no
-// hashing; iteration is in a fixed (brick, then bit) order, so anything derived from a mask
-// is deterministic. Not thread-safe for writes.
+// hashing; iteration is in a fixed (brick, then bit) order whatever the insertion order, so
+// anything derived from a mask is deterministic. insert() is thread-safe (atomic bit-or, brick
+// allocation under a lock); contains()/to_vector() must not race with inserts.
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <cstdint>
+#include <memory>
+#include <mutex>
 #include <vector>
 
 #include "types.h"
@@ -31,23 +35,33 @@ class VoxelMask {
  public:
   VoxelMask() = default;
   explicit VoxelMask(const VoxelBox& box);
+  VoxelMask(VoxelMask&&) noexcept;
+  VoxelMask& operator=(VoxelMask&&) noexcept;
 
   const VoxelBox& box() const { return box_; }
   // Returns true when p was not yet in the set. p must lie inside box().
   bool insert(const Voxel& p);
   bool contains(const Voxel& p) const;
-  int64_t count() const { return count_; }
+  int64_t count() const { return count_.load(std::memory_order_relaxed); }
   std::vector<Voxel> to_vector() const;
 
  private:
   int brick_index(const Voxel& p) const {
     return (((p.z >> 3) - b0_[2]) * bn_[1] + ((p.y >> 3) - b0_[1])) * bn_[0] + ((p.x >> 3) - b0_[0]);  // >> floors (C++20)
   }
+  using Brick = std::array<std::atomic<uint64_t>, 8>;  // 512 bits: bit (x + 8y + 64z)
+  static constexpr int kChunk = 1024;                  // bricks per pool chunk (stable addresses)
+  Brick* brick_at(int32_t index) const { return &(*pool_[size_t(index / kChunk)])[size_t(index % kChunk)]; }
+  int32_t allocate_brick(int b);
+
   VoxelBox box_;
   std::array<int, 3> b0_{}, bn_{};
-  std::vector<int32_t> table_;                 // brick -> index into bricks_, or -1
-  std::vector<std::array<uint64_t, 8>> bricks_;  // 512 bits: bit (x + 8y + 64z)
-  int64_t count_ = 0;
+  std::unique_ptr<std::atomic<int32_t>[]> table_;  // brick -> pool index, or -1
+  size_t table_size_ = 0;
+  std::vector<std::unique_ptr<std::array<Brick, kChunk>>> pool_;
+  int32_t bricks_ = 0;
+  std::mutex alloc_;
+  std::atomic<int64_t> count_{0};
 };
 
 }  // namespace solidtex
