@@ -40,8 +40,11 @@ class LevelStore {
       for (int z = -1; z <= 1; ++z)
         for (int y = -1; y <= 1; ++y)
           for (int x = -1; x <= 1; ++x) {
-            const Voxel c{p.x + 8 * x, p.y + 8 * y, p.z + 8 * z};
-            near_[size_t((z + 1) * 9 + (y + 1) * 3 + (x + 1))] = store.box_.contains(c) ? store.brick(c) : nullptr;
+            const int bx = (p.x >> 3) + x - store.b0_[0], by = (p.y >> 3) + y - store.b0_[1],
+                      bz = (p.z >> 3) + z - store.b0_[2];
+            const bool inside = bx >= 0 && by >= 0 && bz >= 0 && bx < store.bn_[0] && by < store.bn_[1] && bz < store.bn_[2];
+            near_[size_t((z + 1) * 9 + (y + 1) * 3 + (x + 1))] =
+                inside ? store.table_[(size_t(bz) * store.bn_[1] + by) * store.bn_[0] + bx] : nullptr;
           }
     }
     const VoxelState& at(int dx, int dy, int dz, int slot) const {

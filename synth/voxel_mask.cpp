@@ -22,6 +22,8 @@ VoxelMask::VoxelMask(const VoxelBox& box) : box_(box) {
   table_size_ = size_t(bn_[0]) * bn_[1] * bn_[2];
   table_ = std::make_unique<std::atomic<int32_t>[]>(table_size_);
   for (size_t i = 0; i < table_size_; ++i) table_[i].store(-1, std::memory_order_relaxed);
+  // Readers index pool_ without the lock: it must never reallocate.
+  pool_.reserve(table_size_ / kChunk + 1);
 }
 
 VoxelMask::VoxelMask(VoxelMask&& o) noexcept
