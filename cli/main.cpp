@@ -29,6 +29,7 @@ constexpr const char* kUsage =
     "  slice TABLE.stx (--axis x|y|z --at K [--origin U,V] | --plane OX,OY,OZ,UX,UY,UZ,VX,VY,VZ)\n"
     "          --size W,H [--scheme standard|subpass|grid|dual-grid] [--field identity|quat:W,X,Y,Z|FILE]\n"
     "          [--seed S] [--threads T] -o OUT.png [--stats STATS.json]\n"
+    "  field SKETCH.json -o FIELD.stf [--json]\n"
     "  exemplar KIND -o FILE.png [--size W,H] [--seed S]     KIND: wood, stripes, bricks, noise, spots\n";
 
 }  // namespace
@@ -46,6 +47,7 @@ int main(int argc, char** argv) {
     if (command == "analyze") st = cli::run_analyze(args);
     else if (command == "exemplar") st = cli::run_exemplar(args);
     else if (command == "slice") st = cli::run_slice(args);
+    else if (command == "field") st = cli::run_field(args);
     else st = Status(StatusCode::kInvalidArgument, "unknown command '" + command + "'\n" + kUsage, "command");
     if (!st.is_ok()) {
       std::cerr << "solidtex " << command << ": error: " << st.to_string() << "\n";

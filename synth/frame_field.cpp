@@ -1,5 +1,9 @@
 #include "frame_field.h"
 
+#include <cstring>
+
+#include "field_file.h"
+
 #include <nlohmann/json.hpp>
 
 #include <cmath>
@@ -143,8 +147,16 @@ Result<std::shared_ptr<const FrameField>> parse_field_spec(const std::string& sp
     return std::shared_ptr<const FrameField>(
         std::make_shared<ConstantField>(Quat::from_axis_angle(v[0], v[1], v[2], v[3] * M_PI / 180.0)));
   }
+  {
+    std::ifstream probe(spec, std::ios::binary);
+    char magic[8] = {};
+    if (probe && probe.read(magic, 8) && std::memcmp(magic, "STXFIELD", 8) == 0) {
+      SOLIDTEX_ASSIGN_OR_RETURN(auto field, load_field(spec));
+      return std::shared_ptr<const FrameField>(field);
+    }
+  }
   std::ifstream in(spec);
-  if (!in) return Status(StatusCode::kInvalidArgument, "'" + spec + "' is not identity, quat:W,X,Y,Z, axis:X,Y,Z,DEG or a readable file", "field");
+  if (!in) return Status(StatusCode::kInvalidArgument, "'" + spec + "' is not identity, quat:W,X,Y,Z, axis:X,Y,Z,DEG or a readable .stf/.json file", "field");
   nlohmann::json j;
   try {
     j = nlohmann::json::parse(in);

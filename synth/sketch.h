@@ -1,0 +1,39 @@
+// Sketches (Zhang §3): a domain and an ordered list of curves from which a frame field is
+// solved (tensor_field.h). JSON schema: proto/sketch.schema.json. Unknown keys are errors;
+// every validation error names the curve and point ("curves[2].points[5]").
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "status.h"
+#include "types.h"
+
+namespace solidtex {
+
+struct SketchDomain {
+  WorldPoint min{0, 0, 0};      // world units (one unit = one finest voxel by default)
+  WorldPoint max{64, 64, 64};
+  int shortest_side_cells = 24;  // grid cells along the domain's shortest side, [2, 256]
+};
+
+struct SketchCurve {
+  std::vector<WorldPoint> points;          // polyline, >= 2 distinct points, inside the domain
+  std::vector<WorldPoint> normals;         // per-point surface normals (curve on a surface), or
+  std::optional<WorldPoint> plane_normal;  // one reference-plane normal (curve inside the volume)
+  std::optional<int> axis;                 // 0/1/2: the frame axis (x/y/z) that follows the tangent
+  double weight = 100.0;                   // w of Eq. 2, (0, 1e6]
+};
+
+struct Sketch {
+  SketchDomain domain;
+  std::vector<SketchCurve> curves;
+};
+
+Result<Sketch> parse_sketch_json(const std::string& text);
+// One curve object as found in "curves" (also the body of "add a curve" requests).
+Result<SketchCurve> parse_curve_json(const std::string& text, int index);
+Status validate_curve(const SketchCurve& c, const SketchDomain& d, int index);
+
+}  // namespace solidtex
