@@ -1,7 +1,7 @@
 #include "tensor_field.h"
 
+#include <Eigen/IterativeLinearSolvers>
 #include <Eigen/Sparse>
-#include <Eigen/SparseCholesky>
 
 #include <chrono>
 #include <cmath>
@@ -94,6 +94,7 @@ struct FieldSolver::Impl {
   std::vector<Eigen::Triplet<double>> constraint;  // sum over samples of w^2 * b b^T
   std::vector<std::array<double, 4>> rhs;   // sum of w^2 * qbar per node
   std::vector<Quat> solution;               // normalised
+  Eigen::MatrixXd raw_solution;             // n x 4, warm start for the next solve
   int curves = 0;
 
   int index(int x, int y, int z) const { return (z * dims[1] + y) * dims[0] + x; }
@@ -140,13 +141,25 @@ struct FieldSolver::Impl {
     Eigen::SparseMatrix<double> c(n, n);
     c.setFromTriplets(constraint.begin(), constraint.end());
     Eigen::SparseMatrix<double> a = ltl + c;
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(a);
-    if (ldlt.info() != Eigen::Success)
-      return Status(StatusCode::kInternal, "the field's linear system could not be factorised");
-    Eigen::MatrixXd b(n, 4), q;
+    // Conjugate gradients with an incomplete-Cholesky preconditioner, warm-started from the
+    // previous solution (adding a curve changes little), to a tight relative tolerance.
+    Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper,
+                             Eigen::IncompleteCholesky<double>>
+        cg;
+    cg.setTolerance(1e-13);
+    cg.setMaxIterations(20000);
+    cg.compute(a);
+    if (cg.info() != Eigen::Success)
+      return Status(StatusCode::kInternal, "the field's linear system could not be preconditioned");
+    Eigen::MatrixXd b(n, 4), q(n, 4);
     for (int i = 0; i < n; ++i)
       for (int c = 0; c < 4; ++c) b(i, c) = rhs[size_t(i)][size_t(c)];
-    q = ldlt.solve(b);
+    if (raw_solution.rows() != n) raw_solution = Eigen::MatrixXd::Zero(n, 4);
+    for (int c = 0; c < 4; ++c) {
+      Eigen::VectorXd col = cg.solveWithGuess(b.col(c), raw_solution.col(c));
+      q.col(c) = col;
+    }
+    raw_solution = q;
     const double bn = b.norm();
     const double residual = bn > 0 ? (a * q - b).norm() / bn : 0.0;
     int singular = 0, constrained = 0;

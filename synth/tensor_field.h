@@ -9,11 +9,11 @@
 // continuous along itself; later samples take the sign closest to the current field.
 // Each sample softly constrains the trilinear interpolation of its cell's corners with weight w
 // (default 100); the field minimises sum over grid edges ||q_i - q_j||^2 + sum w^2 ||q(p) - qbar||^2, i.e. solves (L + sum w^2 b b^T) Q = sum w^2 b qbar
-// (L the grid's combinatorial Laplacian) for the four components with one sparse Cholesky
-// factorisation. Choice: the paper writes the smoothness term as ||L Q||^2, whose normal
+// (L the grid's combinatorial Laplacian) for the four components by preconditioned conjugate
+// gradients (relative tolerance 1e-13), warm-started from the previous solution. Choice: the paper writes the smoothness term as ||L Q||^2, whose normal
 // equations are a bi-Laplacian; its minimiser and ours both satisfy Eq. 1 (Delta q = 0) away
-// from the curves, and ours factors in well under a second at 32^3 (the bi-Laplacian took
-// minutes at 80x80x16), which is what interactive sketching needs.
+// from the curves, and ours is well conditioned enough for sub-second updates at 32^3 (the
+// bi-Laplacian took minutes at 80x80x16), which is what interactive sketching needs.
 // Nodes whose solution vanishes (|q| < 1e-9) copy a neighbour's frame and count as singular.
 // Adding a curve re-solves the same system with the new constraints: the result is exactly the
 // full solve with all curves.

@@ -121,3 +121,76 @@ TEST(FieldFile, RoundTripAndDamage) {
 
 }  // namespace
 }  // namespace solidtex
+
+// Concentric circles around z drawn in the z = 0 plane steer a grain-x exemplar so that z-cuts
+// show grain running along the circles.
+#include "analysis.h"
+#include "quality.h"
+#include "synthesizer.h"
+#include "test_support.h"
+
+namespace solidtex {
+namespace {
+
+TEST(TensorFieldSynthesis, ConcentricCirclesMakeTangentialGrain) {
+  std::string js = R"({"domain": {"min": [-40, -40, -6], "max": [40, 40, 6], "shortest_side_cells": 6}, "curves": [)";
+  for (int r : {10, 20, 30}) {
+    js += r == 10 ? "" : ",";
+    js += R"({"axis": "x", "plane_normal": [0, 0, 1], "points": [)";
+    for (int i = 0; i <= 48; ++i) {
+      const double a = 2 * M_PI * i / 48 + 0.01 * r;  // closed loop, last point near the first
+      if (i == 48) break;
+      js += (i ? "," : "") + std::string("[") + std::to_string(r * std::cos(a)) + "," + std::to_string(r * std::sin(a)) + ",0]";
+    }
+    js += "]}";
+  }
+  js += "]}";
+  auto sketch = parse_sketch_json(js);
+  ASSERT_TRUE(sketch.is_ok()) << sketch.status().to_string();
+  auto field = FieldSolver::solve(*sketch).value()->field().value();
+
+  ExemplarInputs in;
+  in.xy = testing::procedural(ProceduralKind::kStripes, 48, 48);
+  in.yz = in.xy;
+  in.zx = transposed(in.xy);
+  AnalysisParams ap;
+  ap.levels = 3;
+  ap.neighborhood = 7;
+  ap.candidates = 8;
+  ap.pca_dims = 12;
+  auto table = analyze(ExemplarSet::create(std::move(in)).value(), ap).value().table;
+  SynthesisParams sp;
+  sp.coarse_passes = 2;
+  sp.cell_size = 8;
+  sp.init_subpart = 16;
+  sp.plane_weights = {1.f, 0.1f, 1.f};
+  auto synth = Synthesizer::create(table, field, sp, 0).value();
+  const int side = 72;
+  auto rgb = synth->synthesize(TargetSet::axis_cut('z', 0, -side / 2, -side / 2, side, side).value()).value();
+  ImageF img(side, side, 3);
+  for (size_t i = 0; i < rgb.size(); ++i)
+    for (int c = 0; c < 3; ++c) img.pixels[i * 3 + size_t(c)] = rgb[i][size_t(c)];
+
+  // Local grain orientation in 13x13 windows on rings of radius 12..30 versus the tangent.
+  std::vector<double> errors;
+  for (double r : {13.0, 18.0, 23.0, 28.0})
+    for (int k = 0; k < 16; ++k) {
+      const double a = 2 * M_PI * k / 16;
+      const int cx = int(std::lround(side / 2 + r * std::cos(a))), cy = int(std::lround(side / 2 + r * std::sin(a)));
+      ImageF win(13, 13, 3);
+      for (int y = 0; y < 13; ++y)
+        for (int x = 0; x < 13; ++x)
+          for (int c = 0; c < 3; ++c) win.at(x, y)[c] = img.at(cx - 6 + x, cy - 6 + y)[c];
+      const double grain = dominant_orientation_degrees(win);
+      double tangent = std::atan2(std::cos(a), -std::sin(a)) * 180 / M_PI;
+      double diff = std::fmod(std::abs(grain - tangent), 180.0);
+      errors.push_back(std::min(diff, 180.0 - diff));
+    }
+  std::sort(errors.begin(), errors.end());
+  const double median = errors[errors.size() / 2];
+  RecordProperty("median_error_degrees", std::to_string(median));
+  EXPECT_LE(median, 10.0);
+}
+
+}  // namespace
+}  // namespace solidtex
