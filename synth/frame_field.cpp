@@ -36,29 +36,37 @@ void Rot3::apply(const float l[3], float w[3]) const {
 }
 
 void Rot3::apply_inverse(const float w[3], float l[3]) const {
-  for (int c = 0; c < 3; ++c) l[c] = m[0 * 3 + c] * w[0] + m[1 * 3 + c] * w[1] + m[2 * 3 + c] * w[2];
+  for (int r = 0; r < 3; ++r) l[r] = inv[r * 3 + 0] * w[0] + inv[r * 3 + 1] * w[1] + inv[r * 3 + 2] * w[2];
 }
 
-Rot3 Rot3::from_quat(const Quat& qin) {
+Rot3 Rot3::from_quat(const Quat& qin, const std::array<double, 3>& scale) {
   const Quat q = qin.normalized();
   const double w = q.w, x = q.x, y = q.y, z = q.z;
   Rot3 r;
   r.m = {float(1 - 2 * (y * y + z * z)), float(2 * (x * y - w * z)),     float(2 * (x * z + w * y)),
          float(2 * (x * y + w * z)),     float(1 - 2 * (x * x + z * z)), float(2 * (y * z - w * x)),
          float(2 * (x * z - w * y)),     float(2 * (y * z + w * x)),     float(1 - 2 * (x * x + y * y))};
+  const std::array<float, 9> rot = r.m;
+  for (int row = 0; row < 3; ++row)
+    for (int col = 0; col < 3; ++col) {
+      r.m[size_t(row * 3 + col)] = rot[size_t(row * 3 + col)] * float(scale[size_t(col)]);
+      r.inv[size_t(row * 3 + col)] = rot[size_t(col * 3 + row)] / float(scale[size_t(row)]);
+    }
   return r;
 }
 
 std::string ConstantField::describe() const {
-  if (q_.w == 1 && q_.x == 0 && q_.y == 0 && q_.z == 0) return "identity";
   std::ostringstream s;
   s.precision(17);
-  s << "quat:" << q_.w << "," << q_.x << "," << q_.y << "," << q_.z;
+  if (q_.w == 1 && q_.x == 0 && q_.y == 0 && q_.z == 0) s << "identity";
+  else s << "quat:" << q_.w << "," << q_.x << "," << q_.y << "," << q_.z;
+  if (scale_ != std::array<double, 3>{1, 1, 1}) s << ";scale:" << scale_[0] << "," << scale_[1] << "," << scale_[2];
   return s.str();
 }
 
 Result<std::shared_ptr<const QuatGridField>> QuatGridField::create(WorldPoint origin, double spacing,
-                                                                   std::array<int, 3> dims, std::vector<Quat> values) {
+                                                                   std::array<int, 3> dims, std::vector<Quat> values,
+                                                                   std::vector<std::array<double, 3>> log_scales) {
   if (!(spacing > 0) || !std::isfinite(spacing)) return Status(StatusCode::kInvalidArgument, "must be > 0", "spacing");
   for (int d : dims)
     if (d < 2 || d > 1024) return Status(StatusCode::kInvalidArgument, "each must be in [2, 1024]", "dims");
@@ -73,7 +81,18 @@ Result<std::shared_ptr<const QuatGridField>> QuatGridField::create(WorldPoint or
       return Status(StatusCode::kInvalidArgument, "entry " + std::to_string(i) + " is not a valid rotation", "quaternions");
     values[i] = q.normalized();
   }
+  if (!log_scales.empty() && log_scales.size() != values.size())
+    return Status(StatusCode::kInvalidArgument, "needs one entry per node", "scales");
+  double max_scale = 1;
+  for (const auto& ls : log_scales)
+    for (double v : ls) {
+      if (!std::isfinite(v) || std::exp(v) < kMinScale * 0.999 || std::exp(v) > kMaxScale * 1.001)
+        return Status(StatusCode::kInvalidArgument, "scales must lie in [0.25, 4]", "scales");
+      max_scale = std::max(max_scale, std::exp(v));
+    }
   auto f = std::make_shared<QuatGridField>();
+  f->log_scales_ = std::move(log_scales);
+  f->max_scale_ = max_scale;
   f->origin_ = origin;
   f->spacing_ = spacing;
   f->dims_ = dims;
@@ -81,15 +100,34 @@ Result<std::shared_ptr<const QuatGridField>> QuatGridField::create(WorldPoint or
   return std::shared_ptr<const QuatGridField>(std::move(f));
 }
 
-Quat QuatGridField::at(const WorldPoint& p) const {
+void QuatGridField::cell(const WorldPoint& p, int i0[3], double f[3]) const {
   const double g[3] = {(p.x - origin_.x) / spacing_, (p.y - origin_.y) / spacing_, (p.z - origin_.z) / spacing_};
-  int i0[3];
-  double f[3];
   for (int a = 0; a < 3; ++a) {
     double c = std::clamp(g[a], 0.0, double(dims_[a] - 1));
     i0[a] = std::min(int(std::floor(c)), dims_[a] - 2);
     f[a] = c - i0[a];
   }
+}
+
+std::array<double, 3> QuatGridField::scale_at(const WorldPoint& p) const {
+  if (log_scales_.empty()) return {1, 1, 1};
+  int i0[3];
+  double f[3];
+  cell(p, i0, f);
+  std::array<double, 3> acc{0, 0, 0};
+  for (int c = 0; c < 8; ++c) {
+    const int dx = c & 1, dy = (c >> 1) & 1, dz = (c >> 2) & 1;
+    const double w = (dx ? f[0] : 1 - f[0]) * (dy ? f[1] : 1 - f[1]) * (dz ? f[2] : 1 - f[2]);
+    const auto& v = log_scales_[(size_t(i0[2] + dz) * dims_[1] + (i0[1] + dy)) * dims_[0] + (i0[0] + dx)];
+    for (int a = 0; a < 3; ++a) acc[size_t(a)] += w * v[size_t(a)];
+  }
+  return {std::exp(acc[0]), std::exp(acc[1]), std::exp(acc[2])};
+}
+
+Quat QuatGridField::at(const WorldPoint& p) const {
+  int i0[3];
+  double f[3];
+  cell(p, i0, f);
   auto val = [&](int dx, int dy, int dz) {
     return values_[(size_t(i0[2] + dz) * dims_[1] + (i0[1] + dy)) * dims_[0] + (i0[0] + dx)];
   };
@@ -132,20 +170,31 @@ Result<std::vector<double>> numbers(const std::string& list, size_t count, const
 
 }  // namespace
 
-Result<std::shared_ptr<const FrameField>> parse_field_spec(const std::string& spec) {
-  if (spec == "identity") return std::shared_ptr<const FrameField>(std::make_shared<ConstantField>(Quat{}));
+Result<std::shared_ptr<const FrameField>> parse_field_spec(const std::string& full_spec) {
+  std::string spec = full_spec;
+  std::array<double, 3> scale{1, 1, 1};
+  if (auto semi = full_spec.find(";scale:"); semi != std::string::npos) {
+    SOLIDTEX_ASSIGN_OR_RETURN(auto v, numbers(full_spec.substr(semi + 7), 3, "field"));
+    for (int a = 0; a < 3; ++a) {
+      if (!(v[size_t(a)] >= kMinScale && v[size_t(a)] <= kMaxScale))
+        return Status(StatusCode::kInvalidArgument, "scales must lie in [0.25, 4]", "field");
+      scale[size_t(a)] = v[size_t(a)];
+    }
+    spec = full_spec.substr(0, semi);
+  }
+  if (spec == "identity") return std::shared_ptr<const FrameField>(std::make_shared<ConstantField>(Quat{}, scale));
   if (spec.rfind("quat:", 0) == 0) {
     SOLIDTEX_ASSIGN_OR_RETURN(auto v, numbers(spec.substr(5), 4, "field"));
     Quat q{v[0], v[1], v[2], v[3]};
     if (!(q.dot(q) > 1e-12)) return Status(StatusCode::kInvalidArgument, "quaternion must be non-zero", "field");
-    return std::shared_ptr<const FrameField>(std::make_shared<ConstantField>(q));
+    return std::shared_ptr<const FrameField>(std::make_shared<ConstantField>(q, scale));
   }
   if (spec.rfind("axis:", 0) == 0) {
     SOLIDTEX_ASSIGN_OR_RETURN(auto v, numbers(spec.substr(5), 4, "field"));
     if (!(v[0] * v[0] + v[1] * v[1] + v[2] * v[2] > 0))
       return Status(StatusCode::kInvalidArgument, "rotation axis must be non-zero", "field");
     return std::shared_ptr<const FrameField>(
-        std::make_shared<ConstantField>(Quat::from_axis_angle(v[0], v[1], v[2], v[3] * M_PI / 180.0)));
+        std::make_shared<ConstantField>(Quat::from_axis_angle(v[0], v[1], v[2], v[3] * M_PI / 180.0), scale));
   }
   {
     std::ifstream probe(spec, std::ios::binary);

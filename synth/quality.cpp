@@ -34,6 +34,38 @@ double dominant_orientation_degrees(const ImageF& img) {
   return stripes;
 }
 
+double dominant_period_x(const ImageF& img) {
+  const int w = img.width;
+  std::vector<double> power(size_t(w / 2 + 1), 0.0);
+  std::vector<double> row(static_cast<size_t>(w));
+  for (int y = 0; y < img.height; ++y) {
+    double mean = 0;
+    for (int x = 0; x < w; ++x) {
+      const float* p = img.at(x, y);
+      row[size_t(x)] = img.channels >= 3 ? 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2] : p[0];
+      mean += row[size_t(x)] / w;
+    }
+    for (int k = 1; k <= w / 2; ++k) {
+      double re = 0, im = 0;
+      for (int x = 0; x < w; ++x) {
+        re += (row[size_t(x)] - mean) * std::cos(2 * M_PI * k * x / w);
+        im -= (row[size_t(x)] - mean) * std::sin(2 * M_PI * k * x / w);
+      }
+      power[size_t(k)] += re * re + im * im;
+    }
+  }
+  int best = 2;
+  for (int k = 2; k <= w / 2; ++k)
+    if (power[size_t(k)] > power[size_t(best)]) best = k;
+  double peak = best;
+  if (best > 1 && best < w / 2) {
+    const double a = power[size_t(best - 1)], b = power[size_t(best)], c = power[size_t(best + 1)];
+    const double denom = a - 2 * b + c;
+    if (denom != 0) peak = best + 0.5 * (a - c) / denom;
+  }
+  return double(w) / peak;
+}
+
 double neighbourhood_energy(const ImageF& cut, const ImageF& exemplar, int n, int stride) {
   const int dims = neighborhood_dims(n, exemplar.channels);
   std::vector<float> ex(size_t(exemplar.pixel_count()) * dims);

@@ -73,9 +73,12 @@ Result<std::shared_ptr<Synthesizer>> Synthesizer::create(std::shared_ptr<const T
   s->cache_ = std::make_unique<VoxelCache>(L, cache_bytes);
   s->impl_ = std::make_shared<Impl>();
   const int n = s->table_->params().neighborhood;
-  const int base_reach = int(std::ceil((n / 2) * std::sqrt(2.0)));
+  // A local offset of at most N/2 on two axes reaches N/2 * sqrt(2) * scale voxels.
+  const int base_reach = int(std::ceil((n / 2) * std::sqrt(2.0) * s->field_->max_scale()));
+  if (base_reach + 1 > 120) return Status(StatusCode::kInvalidArgument, "field scales reach too far", "field");
   s->impl_->constant_field = s->field_->is_constant();
-  if (s->impl_->constant_field) s->impl_->constant_rotation = Rot3::from_quat(s->field_->at({0, 0, 0}));
+  if (s->impl_->constant_field)
+    s->impl_->constant_rotation = Rot3::from_quat(s->field_->at({0, 0, 0}), s->field_->scale_at({0, 0, 0}));
   for (int l = 0; l < L; ++l) {
     s->schedules_.push_back(LevelSchedule::make(l, params));
     s->impl_->contexts.push_back(CorrectionContext::make(*s->table_, PyramidLevel{l}, params.plane_weights,
@@ -111,7 +114,10 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize(const TargetSe
 
   auto rotation = [&](int l, const Voxel& p) {
     return impl.constant_field ? impl.constant_rotation
-                               : Rot3::from_quat(field_->at(voxel_centre(PyramidLevel{l}, L, p)));
+                               : [&] {
+                                   const WorldPoint c = voxel_centre(PyramidLevel{l}, L, p);
+                                   return Rot3::from_quat(field_->at(c), field_->scale_at(c));
+                                 }();
   };
 
   // Bounding boxes: a level's sets stay within its final-version box dilated by its reach.

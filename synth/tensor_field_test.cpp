@@ -194,3 +194,44 @@ TEST(TensorFieldSynthesis, ConcentricCirclesMakeTangentialGrain) {
 
 }  // namespace
 }  // namespace solidtex
+
+namespace solidtex {
+namespace {
+
+TEST(ScaleField, ScaleTwoAlongXDoublesThePeriod) {
+  // Stripes varying along x: xy = vertical stripes, zx = horizontal (x is zx's second axis).
+  const ImageF horizontal = testing::procedural(ProceduralKind::kStripes, 48, 48);
+  ExemplarInputs in;
+  in.xy = transposed(horizontal);
+  in.yz = in.xy;
+  in.zx = horizontal;
+  AnalysisParams ap;
+  ap.levels = 3;
+  ap.neighborhood = 7;
+  ap.candidates = 8;
+  ap.pca_dims = 12;
+  auto table = analyze(ExemplarSet::create(std::move(in)).value(), ap).value().table;
+  SynthesisParams sp;
+  sp.coarse_passes = 2;
+  sp.cell_size = 8;
+  sp.init_subpart = 16;
+  sp.plane_weights = {1.f, 0.1f, 1.f};
+  auto period = [&](const char* field) {
+    auto synth = Synthesizer::create(table, parse_field_spec(field).value(), sp, 0).value();
+    const int w = 120, h = 12;
+    auto rgb = synth->synthesize(TargetSet::axis_cut('z', 0, 0, 0, w, h).value()).value();
+    ImageF img(w, h, 3);
+    for (size_t i = 0; i < rgb.size(); ++i)
+      for (int c = 0; c < 3; ++c) img.pixels[i * 3 + size_t(c)] = rgb[i][size_t(c)];
+    return dominant_period_x(img);
+  };
+  const double base = period("identity");
+  const double scaled = period("identity;scale:2,1,1");
+  RecordProperty("period_scale_1", std::to_string(base));
+  RecordProperty("period_scale_2", std::to_string(scaled));
+  EXPECT_NEAR(base, 48.0 / 5.0, 48.0 / 5.0 * 0.15);  // the exemplar's own period
+  EXPECT_NEAR(scaled / base, 2.0, 0.2);
+}
+
+}  // namespace
+}  // namespace solidtex
