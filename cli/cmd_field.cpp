@@ -31,6 +31,7 @@ Status run_field(const std::vector<std::string>& argv) {
   f.dims = solver->dims();
   f.singular_nodes = stats.singular_nodes;
   f.nodes = solver->nodes();
+  f.log_scales = solver->log_scales();
   f.sketch_json = text.str();
   SOLIDTEX_RETURN_IF_ERROR(save_field(out, f));
   if (args.has("--json")) {
@@ -42,7 +43,8 @@ Status run_field(const std::vector<std::string>& argv) {
                         {"nodes", stats.nodes},
                         {"dims", {f.dims[0], f.dims[1], f.dims[2]}},
                         {"spacing", f.spacing},
-                        {"curves", sketch.curves.size()}};
+                        {"curves", sketch.curves.size()},
+                        {"scale_points", sketch.scales.size()}};
     std::cout << j.dump(2) << "\n";
   } else {
     std::cout << "wrote " << out << ": " << f.dims[0] << "x" << f.dims[1] << "x" << f.dims[2] << " nodes, solved in "

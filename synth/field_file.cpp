@@ -29,6 +29,9 @@ std::vector<uint8_t> encode_field(const StoredField& f) {
     w.f64(q.y);
     w.f64(q.z);
   }
+  w.u8(f.log_scales.empty() ? 0 : 1);
+  for (const auto& ls : f.log_scales)
+    for (double v : ls) w.f64(v);
   w.u64(f.sketch_json.size());
   w.bytes(std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(f.sketch_json.data()), f.sketch_json.size()));
   std::vector<uint8_t> payload = std::move(w.buffer());
@@ -80,6 +83,15 @@ Result<StoredField> decode_field(std::span<const uint8_t> bytes) {
     SOLIDTEX_RETURN_IF_ERROR(r.f64(q.y));
     SOLIDTEX_RETURN_IF_ERROR(r.f64(q.z));
   }
+  uint8_t has_scales = 0;
+  SOLIDTEX_RETURN_IF_ERROR(r.u8(has_scales));
+  if (has_scales > 1) return corrupt("flag byte out of range");
+  if (has_scales) {
+    if (uint64_t(n) * 24 > r.remaining()) return corrupt("scale data ends early");
+    f.log_scales.resize(size_t(n));
+    for (auto& ls : f.log_scales)
+      for (double& v : ls) SOLIDTEX_RETURN_IF_ERROR(r.f64(v));
+  }
   uint64_t len = 0;
   SOLIDTEX_RETURN_IF_ERROR(r.u64(len));
   std::vector<uint8_t> text;
@@ -95,7 +107,7 @@ Result<std::shared_ptr<const QuatGridField>> load_field(const std::string& path)
   SOLIDTEX_ASSIGN_OR_RETURN(auto bytes, read_file_bytes(path, int64_t(1) << 30));
   auto f = decode_field(bytes);
   if (!f) return f.status().with_context("'" + path + "'");
-  return QuatGridField::create(f->origin, f->spacing, f->dims, f->nodes);
+  return QuatGridField::create(f->origin, f->spacing, f->dims, f->nodes, f->log_scales);
 }
 
 }  // namespace solidtex

@@ -2,7 +2,8 @@
 //   header: magic "STXFIELD" | u32 version | u32 header bytes (32) | u64 payload bytes |
 //           u64 checksum64(payload)
 //   payload: origin (3 f64), spacing (f64), dims (3 i32), singular node count (i32),
-//            node quaternions (w, x, y, z as f64, x fastest), then the sketch JSON (u64 length
+//            node quaternions (w, x, y, z as f64, x fastest), u8 has-scales and then per node
+//            three f64 log scales, then the sketch JSON (u64 length
 //            + UTF-8 bytes) so a stored field can be extended by more curves later.
 #pragma once
 
@@ -24,6 +25,7 @@ struct StoredField {
   std::array<int, 3> dims{};
   int singular_nodes = 0;
   std::vector<Quat> nodes;
+  std::vector<std::array<double, 3>> log_scales;  // empty or one per node
   std::string sketch_json;
 };
 

@@ -118,7 +118,7 @@ Result<Sketch> parse_sketch_json(const std::string& text) {
   } catch (const std::exception& e) {
     return bad("sketch", std::string("is not valid JSON: ") + e.what());
   }
-  SOLIDTEX_RETURN_IF_ERROR(check_keys(j, {"domain", "curves"}, "sketch"));
+  SOLIDTEX_RETURN_IF_ERROR(check_keys(j, {"domain", "curves", "scales"}, "sketch"));
   Sketch s;
   if (!j.contains("domain")) return bad("domain", "is required");
   SOLIDTEX_RETURN_IF_ERROR(check_keys(j["domain"], {"min", "max", "shortest_side_cells"}, "domain"));
@@ -139,6 +139,31 @@ Result<Sketch> parse_sketch_json(const std::string& text) {
     SOLIDTEX_ASSIGN_OR_RETURN(auto c, curve_from_json(j["curves"][i], int(i)));
     SOLIDTEX_RETURN_IF_ERROR(validate_curve(c, s.domain, int(i)));
     s.curves.push_back(std::move(c));
+  }
+  if (j.contains("scales")) {
+    if (!j["scales"].is_array()) return bad("scales", "must be an array");
+    for (size_t i = 0; i < j["scales"].size(); ++i) {
+      const std::string where = "scales[" + std::to_string(i) + "]";
+      const json& e = j["scales"][i];
+      SOLIDTEX_RETURN_IF_ERROR(check_keys(e, {"point", "scale", "weight"}, where));
+      if (!e.contains("point") || !e.contains("scale")) return bad(where, "needs \"point\" and \"scale\"");
+      ScalePoint sp;
+      SOLIDTEX_ASSIGN_OR_RETURN(sp.point, point(e["point"], where + ".point"));
+      SOLIDTEX_ASSIGN_OR_RETURN(auto sc, point(e["scale"], where + ".scale"));
+      sp.scale = {sc.x, sc.y, sc.z};
+      for (double v : sp.scale)
+        if (!(v >= 0.25 && v <= 4.0)) return bad(where + ".scale", "each factor must be in [0.25, 4]");
+      const WorldPoint& p = sp.point;
+      const SketchDomain& d = s.domain;
+      if (p.x < d.min.x || p.y < d.min.y || p.z < d.min.z || p.x > d.max.x || p.y > d.max.y || p.z > d.max.z)
+        return bad(where + ".point", "lies outside the domain");
+      if (e.contains("weight")) {
+        if (!e["weight"].is_number() || !(e["weight"].get<double>() > 0 && e["weight"].get<double>() <= 1e6))
+          return bad(where + ".weight", "must be in (0, 1e6]");
+        sp.weight = e["weight"].get<double>();
+      }
+      s.scales.push_back(sp);
+    }
   }
   return s;
 }

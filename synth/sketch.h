@@ -3,6 +3,7 @@
 // every validation error names the curve and point ("curves[2].points[5]").
 #pragma once
 
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -26,9 +27,18 @@ struct SketchCurve {
   double weight = 100.0;                   // w of Eq. 2, (0, 1e6]
 };
 
+// A per-axis texture scale at a point (Zhang §3, last paragraph): interpolated harmonically
+// (in log space) like the frames. Scales along the local frame's x, y, z, each in [0.25, 4].
+struct ScalePoint {
+  WorldPoint point;
+  std::array<double, 3> scale{1, 1, 1};
+  double weight = 100.0;
+};
+
 struct Sketch {
   SketchDomain domain;
   std::vector<SketchCurve> curves;
+  std::vector<ScalePoint> scales;  // optional
 };
 
 Result<Sketch> parse_sketch_json(const std::string& text);

@@ -96,6 +96,22 @@ struct FieldSolver::Impl {
   std::vector<Quat> solution;               // normalised
   Eigen::MatrixXd raw_solution;             // n x 4, warm start for the next solve
   int curves = 0;
+  std::vector<std::array<double, 3>> log_scales;
+
+  // CG solve of (L + C) x = b for several right-hand sides (columns), warm-started.
+  Eigen::MatrixXd cg_solve(const std::vector<Eigen::Triplet<double>>& cons, const Eigen::MatrixXd& b,
+                           const Eigen::MatrixXd& guess) const {
+    Eigen::SparseMatrix<double> c(n, n);
+    c.setFromTriplets(cons.begin(), cons.end());
+    Eigen::SparseMatrix<double> a = ltl + c;
+    Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper, Eigen::IncompleteCholesky<double>> cg;
+    cg.setTolerance(1e-13);
+    cg.setMaxIterations(20000);
+    cg.compute(a);
+    Eigen::MatrixXd x(n, b.cols());
+    for (int k = 0; k < b.cols(); ++k) x.col(k) = cg.solveWithGuess(b.col(k), guess.col(k));
+    return x;
+  }
 
   int index(int x, int y, int z) const { return (z * dims[1] + y) * dims[0] + x; }
   // Trilinear corners and weights of a point (clamped into the grid).
@@ -351,15 +367,47 @@ Result<std::unique_ptr<FieldSolver>> FieldSolver::solve(const Sketch& sketch, Fi
   SOLIDTEX_ASSIGN_OR_RETURN(auto solver, create(sketch.domain));
   const auto t0 = std::chrono::steady_clock::now();
   for (size_t i = 0; i < sketch.curves.size(); ++i) SOLIDTEX_RETURN_IF_ERROR(solver->add_curve(sketch.curves[i], int(i), stats));
+  SOLIDTEX_RETURN_IF_ERROR(solver->set_scales(sketch.scales));
   if (stats) stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return solver;
 }
 
 Result<std::shared_ptr<const QuatGridField>> FieldSolver::field() const {
   if (impl_->curves == 0) return Status(StatusCode::kInvalidArgument, "the sketch has no curves", "curves");
-  return QuatGridField::create(impl_->origin, impl_->spacing, impl_->dims, impl_->solution);
+  return QuatGridField::create(impl_->origin, impl_->spacing, impl_->dims, impl_->solution, impl_->log_scales);
 }
 const std::vector<Quat>& FieldSolver::nodes() const { return impl_->solution; }
+const std::vector<std::array<double, 3>>& FieldSolver::log_scales() const { return impl_->log_scales; }
+
+Status FieldSolver::set_scales(const std::vector<ScalePoint>& scales) {
+  Impl& m = *impl_;
+  m.log_scales.clear();
+  if (scales.empty()) return Status::ok();
+  std::vector<Eigen::Triplet<double>> cons;
+  Eigen::MatrixXd b = Eigen::MatrixXd::Zero(m.n, 3);
+  for (size_t i = 0; i < scales.size(); ++i) {
+    const ScalePoint& sp = scales[i];
+    for (double v : sp.scale)
+      if (!(v >= kMinScale && v <= kMaxScale))
+        return Status(StatusCode::kInvalidArgument, "each factor must be in [0.25, 4]", "scales[" + std::to_string(i) + "].scale");
+    std::array<int, 8> idx;
+    std::array<double, 8> w;
+    m.corners(v3(sp.point), idx, w);
+    const double w2 = sp.weight * sp.weight;
+    for (int c = 0; c < 8; ++c) {
+      if (w[size_t(c)] == 0) continue;
+      for (int a = 0; a < 3; ++a) b(idx[size_t(c)], a) += w2 * w[size_t(c)] * std::log(sp.scale[size_t(a)]);
+      for (int e = 0; e < 8; ++e)
+        if (w[size_t(e)] != 0) cons.emplace_back(idx[size_t(c)], idx[size_t(e)], w2 * w[size_t(c)] * w[size_t(e)]);
+    }
+  }
+  const Eigen::MatrixXd x = m.cg_solve(cons, b, Eigen::MatrixXd::Zero(m.n, 3));
+  m.log_scales.resize(size_t(m.n));
+  for (int i = 0; i < m.n; ++i)
+    for (int a = 0; a < 3; ++a)
+      m.log_scales[size_t(i)][size_t(a)] = std::clamp(x(i, a), std::log(kMinScale), std::log(kMaxScale));
+  return Status::ok();
+}
 std::array<int, 3> FieldSolver::dims() const { return impl_->dims; }
 WorldPoint FieldSolver::origin() const { return impl_->origin; }
 double FieldSolver::spacing() const { return impl_->spacing; }

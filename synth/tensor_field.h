@@ -44,13 +44,17 @@ class FieldSolver {
 
   // Adds a validated curve and re-solves. `index` is only used in error messages.
   Status add_curve(const SketchCurve& curve, int index, FieldSolveStats* stats = nullptr);
-  // Solves a whole sketch: every curve in order.
+  // Sets the sparse scale points (replacing earlier ones) and solves the log-scale field.
+  Status set_scales(const std::vector<ScalePoint>& scales);
+  // Solves a whole sketch: every curve in order, then the scales.
   static Result<std::unique_ptr<FieldSolver>> solve(const Sketch& sketch, FieldSolveStats* stats = nullptr);
 
   // The normalised field (trilinear, sign-aligned corners). Requires at least one curve.
   Result<std::shared_ptr<const QuatGridField>> field() const;
   // Normalised node quaternions, x fastest.
   const std::vector<Quat>& nodes() const;
+  // Per-node log scales (x fastest), empty when the sketch has no scale points.
+  const std::vector<std::array<double, 3>>& log_scales() const;
   std::array<int, 3> dims() const;
   WorldPoint origin() const;
   double spacing() const;

@@ -102,9 +102,30 @@ TEST(TensorField, MalformedSketchesNameTheProblem) {
   EXPECT_EQ(nan.status().field(), "curves[0].weight");
 }
 
+TEST(TensorField, SketchedScalesInterpolateBetweenPoints) {
+  auto sketch = parse_sketch_json(
+      R"({"domain": {"min": [0, 0, 0], "max": [40, 20, 20], "shortest_side_cells": 5},
+          "curves": [{"points": [[5, 10, 10], [35, 10, 10]], "plane_normal": [0, 0, 1]}],
+          "scales": [{"point": [0, 10, 10], "scale": [1, 1, 1]}, {"point": [40, 10, 10], "scale": [4, 1, 0.5]}]})");
+  ASSERT_TRUE(sketch.is_ok()) << sketch.status().to_string();
+  auto field = FieldSolver::solve(*sketch).value()->field().value();
+  const auto a = field->scale_at({0, 10, 10}), b = field->scale_at({40, 10, 10}), mid = field->scale_at({20, 10, 10});
+  EXPECT_NEAR(a[0], 1.0, 0.02);
+  EXPECT_NEAR(b[0], 4.0, 0.08);
+  EXPECT_NEAR(b[2], 0.5, 0.01);
+  EXPECT_GT(mid[0], 1.3);  // harmonic in log space: between the two
+  EXPECT_LT(mid[0], 3.0);
+  EXPECT_NEAR(mid[1], 1.0, 1e-6);
+  EXPECT_NEAR(field->max_scale(), 4.0, 0.08);
+  auto bad = parse_sketch_json(
+      R"({"domain": {"min": [0, 0, 0], "max": [8, 8, 8]}, "curves": [{"points": [[1,1,1],[2,2,2]], "plane_normal": [0,0,1]}],
+          "scales": [{"point": [1, 1, 1], "scale": [9, 1, 1]}]})");
+  EXPECT_EQ(bad.status().field(), "scales[0].scale");
+}
+
 TEST(FieldFile, RoundTripAndDamage) {
   auto solver = FieldSolver::solve(parse_sketch_json(arc_sketch(6, 20, 6, false)).value()).value();
-  StoredField f{solver->origin(), solver->spacing(), solver->dims(), 0, solver->nodes(), "{}"};
+  StoredField f{solver->origin(), solver->spacing(), solver->dims(), 0, solver->nodes(), {}, "{}"};
   auto bytes = encode_field(f);
   auto back = decode_field(bytes);
   ASSERT_TRUE(back.is_ok());
