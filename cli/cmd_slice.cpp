@@ -12,6 +12,7 @@
 #include "image_io.h"
 #include "progress_bar.h"
 #include "quality.h"
+#include "region_volume.h"
 #include "synthesizer.h"
 #include "table_file.h"
 
@@ -57,7 +58,7 @@ Result<TargetSet> parse_cut(const Args& args) {
 
 Status run_slice(const std::vector<std::string>& argv) {
   Args args({"-o", "--axis", "--at", "--origin", "--plane", "--size", "--scheme", "--field", "--seed", "--threads",
-             "--stats", "--passes", "--coarse-passes", "--cell", "--cache-mb", "--plane-weights", "--matcher"},
+             "--stats", "--passes", "--coarse-passes", "--cell", "--cache-mb", "--plane-weights", "--matcher", "--region-table", "--regions"},
             {"--energy"});
   SOLIDTEX_RETURN_IF_ERROR(args.parse(argv));
   if (args.positionals().size() != 1)
@@ -90,7 +91,27 @@ Status run_slice(const std::vector<std::string>& argv) {
   SOLIDTEX_ASSIGN_OR_RETURN(auto synth, Synthesizer::create(table, field, params, int64_t(cache_mb) << 20));
   ProgressBar bar;
   SynthesisStats stats;
-  SOLIDTEX_ASSIGN_OR_RETURN(auto rgb, synth->synthesize(target, bar, &stats));
+  std::vector<std::array<float, 3>> rgb;
+  if (args.has("--region-table") != args.has("--regions"))
+    return Status(StatusCode::kInvalidArgument, "--region-table and --regions go together", "--regions");
+  if (auto second = args.get("--region-table")) {
+    // Label 1 of --regions takes the second table's texture (same field and parameters).
+    SOLIDTEX_ASSIGN_OR_RETURN(auto label, RegionLabel::parse(*args.get("--regions")));
+    SOLIDTEX_ASSIGN_OR_RETURN(auto table2, load_table(*second));
+    SynthesisParams p2 = params;
+    if (!args.has("--plane-weights")) p2.plane_weights = table2->params().suggested_plane_weights;
+    SOLIDTEX_ASSIGN_OR_RETURN(auto synth2, Synthesizer::create(table2, field, p2, int64_t(cache_mb) << 20));
+    SOLIDTEX_ASSIGN_OR_RETURN(auto volume, RegionVolume::create({synth, synth2}, label));
+    std::vector<SynthesisStats> per_region;
+    SOLIDTEX_ASSIGN_OR_RETURN(rgb, volume->synthesize(target, bar, &per_region));
+    for (const SynthesisStats& r : per_region) {
+      stats.voxels += r.voxels;
+      stats.corrections += r.corrections;
+      stats.seconds += r.seconds;
+    }
+  } else {
+    SOLIDTEX_ASSIGN_OR_RETURN(rgb, synth->synthesize(target, bar, &stats));
+  }
   ImageF img(target.width, target.height, 3);
   for (size_t i = 0; i < rgb.size(); ++i)
     for (int c = 0; c < 3; ++c) img.pixels[i * 3 + size_t(c)] = rgb[i][size_t(c)];

@@ -51,6 +51,26 @@ class Poller {
 Voxel add(const Voxel& p, const std::array<int8_t, 3>& o) { return {p.x + o[0], p.y + o[1], p.z + o[2]}; }
 Voxel parent_of(const Voxel& p) { return {floor_div(p.x, 2), floor_div(p.y, 2), floor_div(p.z, 2)}; }
 
+// The frame of a voxel: at the finest level the field at its centre; at coarser levels the
+// field is smoothed over the voxel's footprint (Zhang §6), as the sign-aligned, renormalised
+// mean of 8 samples at +-1/4 of the voxel's size around the centre (log scales averaged too).
+Rot3 smoothed_frame(const FrameField& field, const WorldPoint& c, int level, int levels) {
+  if (level == levels - 1) return Rot3::from_quat(field.at(c), field.scale_at(c));
+  const double r = 0.25 * double(stack_spacing(PyramidLevel{level}, levels));
+  Quat acc{0, 0, 0, 0}, ref{};
+  std::array<double, 3> log_scale{0, 0, 0};
+  for (int k = 0; k < 8; ++k) {
+    const WorldPoint q{c.x + ((k & 1) ? r : -r), c.y + ((k & 2) ? r : -r), c.z + ((k & 4) ? r : -r)};
+    Quat f = field.at(q);
+    if (k == 0) ref = f;
+    if (f.dot(ref) < 0) f = {-f.w, -f.x, -f.y, -f.z};
+    acc = {acc.w + f.w, acc.x + f.x, acc.y + f.y, acc.z + f.z};
+    const auto sc = field.scale_at(q);
+    for (int a = 0; a < 3; ++a) log_scale[size_t(a)] += std::log(sc[size_t(a)]) / 8;
+  }
+  return Rot3::from_quat(acc.normalized(), {std::exp(log_scale[0]), std::exp(log_scale[1]), std::exp(log_scale[2])});
+}
+
 const VoxelState& dummy_state() {
   static const VoxelState s{};
   return s;
@@ -114,10 +134,7 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize(const TargetSe
 
   auto rotation = [&](int l, const Voxel& p) {
     return impl.constant_field ? impl.constant_rotation
-                               : [&] {
-                                   const WorldPoint c = voxel_centre(PyramidLevel{l}, L, p);
-                                   return Rot3::from_quat(field_->at(c), field_->scale_at(c));
-                                 }();
+                               : smoothed_frame(*field_, voxel_centre(PyramidLevel{l}, L, p), l, L);
   };
 
   // Bounding boxes: a level's sets stay within its final-version box dilated by its reach.

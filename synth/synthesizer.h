@@ -9,6 +9,8 @@
 //     exactly the voxels it updates within the sets, in parallel (TBB).
 // Purity: the value of (level, voxel, version) depends only on the table, field, parameters
 // and seed: never on the request, order, thread count or cache state (tests check bits).
+// Fields: the finest level uses the field at each voxel centre; coarser levels a smoothed
+// field (mean of 8 samples over the voxel's footprint), as in Zhang §6.
 // Thread-safety: synthesize() may run concurrently; requests share only the VoxelCache.
 #pragma once
 

@@ -5,6 +5,7 @@
 
 #include "analysis.h"
 #include "quality.h"
+#include "region_volume.h"
 #include "test_support.h"
 
 namespace solidtex {
@@ -228,6 +229,28 @@ TEST(SynthesizerOrientation, ConstantRotationTurnsTheGrain) {
   RecordProperty("orientation_rotated", std::to_string(turned));
   EXPECT_NEAR(straight, 0.0, 5.0);
   EXPECT_NEAR(turned - straight, 45.0, 5.0);
+}
+
+TEST(RegionVolume, LabelsPickTheRightTableOnBothSidesOfASplit) {
+  auto spots = small_table(ProceduralKind::kSpots, false);
+  auto noise = small_table(ProceduralKind::kNoise, false);
+  auto a = make(spots, "identity", small_params(), 0);
+  auto b = make(noise, "identity", small_params(), 0);
+  auto volume = RegionVolume::create({a, b}, RegionLabel::parse("halfspace:1,0,0,0").value()).value();
+  const auto target = TargetSet::axis_cut('z', 1, -10, 0, 20, 12).value();
+  auto mixed = volume->synthesize(target).value();
+  const auto only_a = cut(*make(spots, "identity", small_params(), 0), 'z', 1, -10, 0, 20, 12);
+  const auto only_b = cut(*make(noise, "identity", small_params(), 0), 'z', 1, -10, 0, 20, 12);
+  for (int j = 0; j < 12; ++j)
+    for (int i = 0; i < 20; ++i) {
+      const size_t s = size_t(j * 20 + i);
+      // x = -10 + i: x < 0 is region 0 (spots), x >= 0 region 1 (noise), bit for bit.
+      ASSERT_EQ(mixed[s], (i < 10 ? only_a : only_b)[s]) << i << "," << j;
+    }
+  EXPECT_NE(only_a, only_b);
+  EXPECT_FALSE(RegionLabel::parse("halfspace:0,0,0,1").is_ok());
+  EXPECT_FALSE(RegionLabel::parse("ball:1,2").is_ok());
+  EXPECT_EQ(RegionLabel::parse("box:0,0,0,4,4,4").value().label_of({2, 2, 2}), 1);
 }
 
 TEST(Synthesizer, RejectsBadInputAndHonoursCancellation) {
