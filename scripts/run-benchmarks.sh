@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Runs every benchmark in bench/ and prints one JSON document: {"analysis": [...], "slice": {...}}.
+# Runs every benchmark in bench/ and prints one JSON document:
+#   {"analysis": [...], "slice": {...}, "field": {...}}. Takes about 20 minutes on 2 cores.
 # Uses ../shared/data/exemplars/wood_grain.png when present, else a procedural wood exemplar.
 set -euo pipefail
 build=${1:-build}
@@ -23,4 +24,6 @@ fi
 "$build/bin/solidtex" analyze "$exemplar" --grain x -o "$tmp/wood.stx" >/dev/null
 echo '"slice":'
 "$build/bin/bench_slice" "$tmp/wood.stx" $quick
+echo ', "field":'
+"$build/bin/bench_field"
 echo '}'
