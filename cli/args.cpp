@@ -1,5 +1,7 @@
 #include "args.h"
 
+#include "number_list.h"
+
 #include <cctype>
 #include <charconv>
 #include <cstdlib>
@@ -76,20 +78,7 @@ Result<double> Args::get_double(const std::string& name, double fallback, double
 
 Result<std::vector<double>> Args::get_list(const std::string& name, size_t count) const {
   SOLIDTEX_ASSIGN_OR_RETURN(std::string v, required(name));
-  std::vector<double> out;
-  std::stringstream ss(v);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    char* end = nullptr;
-    double d = std::strtod(item.c_str(), &end);
-    if (item.empty() || end != item.c_str() + item.size() || !std::isfinite(d))
-      return Status(StatusCode::kInvalidArgument, "'" + item + "' in '" + v + "' is not a number", name);
-    out.push_back(d);
-  }
-  if (out.size() != count)
-    return Status(StatusCode::kInvalidArgument,
-                  "expects " + std::to_string(count) + " comma-separated numbers, got '" + v + "'", name);
-  return out;
+  return parse_number_list(v, count, name);
 }
 
 }  // namespace solidtex::cli

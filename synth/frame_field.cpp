@@ -3,6 +3,7 @@
 #include <cstring>
 
 #include "field_file.h"
+#include "number_list.h"
 
 #include <nlohmann/json.hpp>
 
@@ -152,29 +153,13 @@ std::string QuatGridField::describe() const {
 
 namespace {
 
-Result<std::vector<double>> numbers(const std::string& list, size_t count, const char* field) {
-  std::vector<double> out;
-  std::stringstream ss(list);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    char* end = nullptr;
-    double d = std::strtod(item.c_str(), &end);
-    if (item.empty() || end != item.c_str() + item.size() || !std::isfinite(d))
-      return Status(StatusCode::kInvalidArgument, "'" + item + "' is not a number", field);
-    out.push_back(d);
-  }
-  if (out.size() != count)
-    return Status(StatusCode::kInvalidArgument, "expects " + std::to_string(count) + " numbers", field);
-  return out;
-}
-
 }  // namespace
 
 Result<std::shared_ptr<const FrameField>> parse_field_spec(const std::string& full_spec) {
   std::string spec = full_spec;
   std::array<double, 3> scale{1, 1, 1};
   if (auto semi = full_spec.find(";scale:"); semi != std::string::npos) {
-    SOLIDTEX_ASSIGN_OR_RETURN(auto v, numbers(full_spec.substr(semi + 7), 3, "field"));
+    SOLIDTEX_ASSIGN_OR_RETURN(auto v, parse_number_list(full_spec.substr(semi + 7), 3, "field"));
     for (int a = 0; a < 3; ++a) {
       if (!(v[size_t(a)] >= kMinScale && v[size_t(a)] <= kMaxScale))
         return Status(StatusCode::kInvalidArgument, "scales must lie in [0.25, 4]", "field");
@@ -184,13 +169,13 @@ Result<std::shared_ptr<const FrameField>> parse_field_spec(const std::string& fu
   }
   if (spec == "identity") return std::shared_ptr<const FrameField>(std::make_shared<ConstantField>(Quat{}, scale));
   if (spec.rfind("quat:", 0) == 0) {
-    SOLIDTEX_ASSIGN_OR_RETURN(auto v, numbers(spec.substr(5), 4, "field"));
+    SOLIDTEX_ASSIGN_OR_RETURN(auto v, parse_number_list(spec.substr(5), 4, "field"));
     Quat q{v[0], v[1], v[2], v[3]};
     if (!(q.dot(q) > 1e-12)) return Status(StatusCode::kInvalidArgument, "quaternion must be non-zero", "field");
     return std::shared_ptr<const FrameField>(std::make_shared<ConstantField>(q, scale));
   }
   if (spec.rfind("axis:", 0) == 0) {
-    SOLIDTEX_ASSIGN_OR_RETURN(auto v, numbers(spec.substr(5), 4, "field"));
+    SOLIDTEX_ASSIGN_OR_RETURN(auto v, parse_number_list(spec.substr(5), 4, "field"));
     if (!(v[0] * v[0] + v[1] * v[1] + v[2] * v[2] > 0))
       return Status(StatusCode::kInvalidArgument, "rotation axis must be non-zero", "field");
     return std::shared_ptr<const FrameField>(

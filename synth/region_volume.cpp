@@ -1,7 +1,7 @@
 #include "region_volume.h"
 
-#include <cmath>
-#include <sstream>
+#include "number_list.h"
+
 
 namespace solidtex {
 
@@ -11,24 +11,9 @@ int RegionLabel::label_of(const WorldPoint& p) const {
 }
 
 Result<RegionLabel> RegionLabel::parse(const std::string& spec) {
-  auto numbers = [&](const std::string& list, size_t count) -> Result<std::vector<double>> {
-    std::vector<double> out;
-    std::stringstream ss(list);
-    std::string item;
-    while (std::getline(ss, item, ',')) {
-      char* end = nullptr;
-      const double d = std::strtod(item.c_str(), &end);
-      if (item.empty() || end != item.c_str() + item.size() || !std::isfinite(d))
-        return Status(StatusCode::kInvalidArgument, "'" + item + "' is not a number", "regions");
-      out.push_back(d);
-    }
-    if (out.size() != count)
-      return Status(StatusCode::kInvalidArgument, "expects " + std::to_string(count) + " numbers", "regions");
-    return out;
-  };
   RegionLabel l;
   if (spec.rfind("halfspace:", 0) == 0) {
-    SOLIDTEX_ASSIGN_OR_RETURN(auto v, numbers(spec.substr(10), 4));
+    SOLIDTEX_ASSIGN_OR_RETURN(auto v, parse_number_list(spec.substr(10), 4, "regions"));
     if (v[0] == 0 && v[1] == 0 && v[2] == 0)
       return Status(StatusCode::kInvalidArgument, "half-space normal must be non-zero", "regions");
     l.kind = Kind::kHalfSpace;
@@ -37,7 +22,7 @@ Result<RegionLabel> RegionLabel::parse(const std::string& spec) {
     return l;
   }
   if (spec.rfind("box:", 0) == 0) {
-    SOLIDTEX_ASSIGN_OR_RETURN(auto v, numbers(spec.substr(4), 6));
+    SOLIDTEX_ASSIGN_OR_RETURN(auto v, parse_number_list(spec.substr(4), 6, "regions"));
     if (!(v[3] >= v[0] && v[4] >= v[1] && v[5] >= v[2]))
       return Status(StatusCode::kInvalidArgument, "box max must not be below its min", "regions");
     l.kind = Kind::kBox;
