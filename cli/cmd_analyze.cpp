@@ -55,18 +55,7 @@ Status run_analyze(const std::vector<std::string>& argv) {
   SOLIDTEX_ASSIGN_OR_RETURN(in.mask_yz, optional_image(args, "--mask-yz", "mask_yz"));
   SOLIDTEX_ASSIGN_OR_RETURN(in.mask_zx, optional_image(args, "--mask-zx", "mask_zx"));
   if (auto grain = args.get("--grain")) {
-    // An anisotropic exemplar whose stripes run along its x axis, for a solid whose grain runs
-    // along world x: xy = E, zx = E transposed (consistent in 3D), yz = E (the end grain the
-    // exemplar cannot show; synthesis gives it a small weight).
-    if (*grain != "x") return Status(StatusCode::kInvalidArgument, "only 'x' is supported", "--grain");
-    if (in.yz || in.zx) return Status(StatusCode::kInvalidArgument, "cannot be combined with --yz/--zx", "--grain");
-    in.yz = in.xy;
-    in.zx = transposed(in.xy);
-    if (in.mask_xy) {
-      in.mask_yz = in.mask_xy;
-      in.mask_zx = transposed(*in.mask_xy);
-    }
-    params.suggested_plane_weights = {1.f, 0.1f, 1.f};
+    SOLIDTEX_RETURN_IF_ERROR(apply_grain_layout(*grain, in, params.suggested_plane_weights).with_context("--grain"));
   }
   SOLIDTEX_ASSIGN_OR_RETURN(double mw, args.get_double("--mask-weight", 1.0, 0.0, 10.0));
   in.mask_weight = float(mw);

@@ -13,6 +13,7 @@ Status run_analyze(const std::vector<std::string>& args);
 Status run_exemplar(const std::vector<std::string>& args);
 Status run_slice(const std::vector<std::string>& args);
 Status run_field(const std::vector<std::string>& args);
+Status run_serve(const std::vector<std::string>& args);
 
 // Applies --threads (0 = all cores) for the rest of the process.
 void set_thread_limit(int threads);

@@ -30,6 +30,8 @@ constexpr const char* kUsage =
     "          --size W,H [--scheme standard|subpass|grid|dual-grid] [--field identity|quat:W,X,Y,Z|FILE]\n"
     "          [--seed S] [--threads T] -o OUT.png [--stats STATS.json]\n"
     "  field SKETCH.json -o FIELD.stf [--json]\n"
+    "  serve [--host 127.0.0.1] [--port 8080] [--data DIR] [--threads N] [--queue N] [--deadline S]\n"
+    "          [--cache-mb M] [--max-upload-mb M] [--max-image-side PX] [--max-voxels N] [--max-jobs N]\n"
     "  exemplar KIND -o FILE.png [--size W,H] [--seed S]     KIND: wood, stripes, bricks, noise, spots\n";
 
 }  // namespace
@@ -48,6 +50,7 @@ int main(int argc, char** argv) {
     else if (command == "exemplar") st = cli::run_exemplar(args);
     else if (command == "slice") st = cli::run_slice(args);
     else if (command == "field") st = cli::run_field(args);
+    else if (command == "serve") st = cli::run_serve(args);
     else st = Status(StatusCode::kInvalidArgument, "unknown command '" + command + "'\n" + kUsage, "command");
     if (!st.is_ok()) {
       std::cerr << "solidtex " << command << ": error: " << st.to_string() << "\n";

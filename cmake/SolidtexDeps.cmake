@@ -24,3 +24,11 @@ find_package(OpenVDB QUIET)
 if(OpenVDB_FOUND)
   add_library(solidtex::openvdb ALIAS OpenVDB::openvdb)
 endif()
+
+# RESTinio (header-only; standalone Asio, fmt, http_parser). Only server/http_server.cpp uses it.
+find_package(fmt REQUIRED)
+find_library(HTTP_PARSER_LIBRARY http_parser REQUIRED)
+add_library(solidtex_restinio INTERFACE)
+target_compile_definitions(solidtex_restinio INTERFACE ASIO_STANDALONE ASIO_HAS_STD_CHRONO ASIO_DISABLE_STD_STRING_VIEW)
+target_link_libraries(solidtex_restinio INTERFACE fmt::fmt ${HTTP_PARSER_LIBRARY} Threads::Threads)
+add_library(solidtex::restinio ALIAS solidtex_restinio)

@@ -86,4 +86,19 @@ Result<ExemplarSet> ExemplarSet::from_matching_images(std::array<std::shared_ptr
   return set;
 }
 
+Status apply_grain_layout(const std::string& grain, ExemplarInputs& in,
+                          std::array<float, 3>& suggested_plane_weights) {
+  if (grain.empty()) return Status::ok();
+  if (grain != "x") return Status(StatusCode::kInvalidArgument, "only 'x' is supported", "grain");
+  if (in.yz || in.zx) return Status(StatusCode::kInvalidArgument, "cannot be combined with yz/zx exemplars", "grain");
+  in.yz = in.xy;
+  in.zx = transposed(in.xy);
+  if (in.mask_xy) {
+    in.mask_yz = in.mask_xy;
+    in.mask_zx = transposed(*in.mask_xy);
+  }
+  suggested_plane_weights = {1.f, 0.1f, 1.f};
+  return Status::ok();
+}
+
 }  // namespace solidtex

@@ -8,6 +8,7 @@
 #include <array>
 #include <memory>
 #include <optional>
+#include <string>
 
 #include "image.h"
 #include "status.h"
@@ -24,6 +25,14 @@ struct ExemplarInputs {
   std::optional<ImageF> mask_yz, mask_zx;  // required with yz/zx when mask_xy is given
   float mask_weight = 1.0f;           // scale of the mask channel relative to colour, [0, 10]
 };
+
+// Grain layouts (shared by `solidtex analyze --grain` and the service's `grain` parameter).
+// "x": an anisotropic exemplar whose stripes run along its x axis, for a solid whose grain
+// runs along world x: xy = E, zx = E transposed (consistent in 3D), yz = E (the end grain
+// the exemplar cannot show, so the returned suggested plane weights give it 0.1).
+// Fails when the inputs already have yz/zx. "" leaves everything unchanged.
+Status apply_grain_layout(const std::string& grain, ExemplarInputs& inputs,
+                          std::array<float, 3>& suggested_plane_weights);
 
 class ExemplarSet {
  public:

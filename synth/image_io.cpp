@@ -153,10 +153,27 @@ Status write_bytes(const std::string& path, const std::vector<uint8_t>& bytes) {
 
 }  // namespace
 
+std::vector<uint8_t> to_srgb8(const ImageF& rgb_linear) {
+  std::vector<uint8_t> out(rgb_linear.pixels.size());
+  for (size_t i = 0; i < out.size(); ++i)
+    out[i] = uint8_t(std::lround(linear_to_srgb(std::clamp(rgb_linear.pixels[i], 0.f, 1.f)) * 255.f));
+  return out;
+}
+
 Result<std::vector<uint8_t>> encode_png_srgb8(const ImageF& rgb_linear) {
-  if (rgb_linear.channels != 3)
-    return Status(StatusCode::kInvalidArgument, "expected a 3-channel linear RGB image");
-  return encode_png(rgb_linear, OIIO::TypeDesc::UINT8, true);
+  if (rgb_linear.channels != 3 || rgb_linear.empty())
+    return Status(StatusCode::kInvalidArgument, "expected a non-empty 3-channel linear RGB image");
+  // Quantised by to_srgb8, so a PNG and a raw sRGB8 answer hold the same bytes.
+  const std::vector<uint8_t> px = to_srgb8(rgb_linear);
+  std::vector<unsigned char> out;
+  OIIO::Filesystem::IOVecOutput writer(out);
+  OIIO::ImageSpec spec(rgb_linear.width, rgb_linear.height, 3, OIIO::TypeDesc::UINT8);
+  spec.attribute("oiio:ColorSpace", "sRGB");
+  auto o = OIIO::ImageOutput::create("out.png", &writer);
+  if (!o) return Status(StatusCode::kInternal, "no PNG writer: " + OIIO::geterror());
+  if (!o->open("out.png", spec) || !o->write_image(OIIO::TypeDesc::UINT8, px.data()) || !o->close())
+    return Status(StatusCode::kInternal, "PNG encoding failed: " + o->geterror());
+  return std::vector<uint8_t>(out.begin(), out.end());
 }
 
 Status save_png_srgb8(const std::string& path, const ImageF& rgb_linear) {

@@ -36,7 +36,9 @@ Result<ImageF> load_image(const std::string& path, const ImageLimits& limits = {
 // Reads a whole file with a size cap (kTooLarge beyond it).
 Result<std::vector<uint8_t>> read_file_bytes(const std::string& path, int64_t max_bytes);
 
-// Encodes a linear-RGB image (3 channels) as an 8-bit sRGB PNG.
+// Linear RGB -> 8-bit sRGB bytes (clamped, sRGB curve, rounded), interleaved like the image.
+std::vector<uint8_t> to_srgb8(const ImageF& rgb_linear);
+// Encodes a linear-RGB image (3 channels) as an 8-bit sRGB PNG (quantised by to_srgb8).
 Result<std::vector<uint8_t>> encode_png_srgb8(const ImageF& rgb_linear);
 Status save_png_srgb8(const std::string& path, const ImageF& rgb_linear);
 

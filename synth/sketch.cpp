@@ -1,5 +1,7 @@
 #include "sketch.h"
 
+#include "json_fields.h"
+
 #include <nlohmann/json.hpp>
 
 #include <cmath>
@@ -12,23 +14,7 @@ using nlohmann::json;
 
 Status bad(const std::string& field, const std::string& msg) { return Status(StatusCode::kInvalidArgument, msg, field); }
 
-Status check_keys(const json& j, const std::set<std::string>& allowed, const std::string& where) {
-  if (!j.is_object()) return bad(where, "must be a JSON object");
-  for (auto it = j.begin(); it != j.end(); ++it)
-    if (!allowed.count(it.key())) return bad(where + "." + it.key(), "unknown key");
-  return Status::ok();
-}
-
-Result<WorldPoint> point(const json& j, const std::string& where) {
-  if (!j.is_array() || j.size() != 3) return bad(where, "must be an array of 3 numbers");
-  double v[3];
-  for (int i = 0; i < 3; ++i) {
-    if (!j[size_t(i)].is_number()) return bad(where, "must be an array of 3 numbers");
-    v[i] = j[size_t(i)].get<double>();
-    if (!std::isfinite(v[i])) return bad(where, "must be finite");
-  }
-  return WorldPoint{v[0], v[1], v[2]};
-}
+Result<WorldPoint> point(const json& j, const std::string& where) { return json_point(j, where); }
 
 double len(const WorldPoint& p) { return std::sqrt(p.x * p.x + p.y * p.y + p.z * p.z); }
 WorldPoint sub(const WorldPoint& a, const WorldPoint& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }

@@ -15,6 +15,9 @@ const char* status_code_name(StatusCode code) {
     case StatusCode::kDeadlineExceeded: return "deadline_exceeded";
     case StatusCode::kResourceExhausted: return "resource_exhausted";
     case StatusCode::kAlreadyExists: return "already_exists";
+    case StatusCode::kFailedPrecondition: return "failed_precondition";
+    case StatusCode::kUnprocessable: return "unprocessable";
+    case StatusCode::kRateLimited: return "rate_limited";
     case StatusCode::kInternal: return "internal";
     case StatusCode::kIo: return "io";
   }

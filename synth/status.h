@@ -22,6 +22,9 @@ enum class StatusCode {
   kDeadlineExceeded,
   kResourceExhausted,  // queue full, budget spent
   kAlreadyExists,
+  kFailedPrecondition, // the target is not in a state that allows this (in use, not ready)
+  kUnprocessable,      // well-formed input whose content cannot be used (e.g. image too big in pixels)
+  kRateLimited,        // too many concurrent operations of this kind for now; retry later
   kInternal,
   kIo,                 // the operating system refused a read or write
 };

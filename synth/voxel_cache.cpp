@@ -78,7 +78,8 @@ int64_t VoxelCache::lookup(PyramidLevel level, const std::vector<Voxel>& voxels,
 }
 
 void VoxelCache::insert(PyramidLevel level, const std::vector<Voxel>& voxels, const std::vector<CoordinateTriple>& triples) {
-  if (budget_ <= 0) return;
+  const int64_t budget = budget_.load();
+  if (budget <= 0) return;
   std::lock_guard<std::mutex> g(impl_->mutex);
   auto& grid = *impl_->grids[size_t(level.index)];
   auto acc = grid.getAccessor();
@@ -98,14 +99,14 @@ void VoxelCache::insert(PyramidLevel level, const std::vector<Voxel>& voxels, co
   // Evict least-recently-used leaves (over all levels) while over budget.
   int64_t leaves = 0;
   for (auto& gr : impl_->grids) leaves += gr->tree().leafCount();
-  if (leaves * impl_->leaf_bytes <= budget_) return;
+  if (leaves * impl_->leaf_bytes <= budget) return;
   std::vector<std::tuple<uint64_t, int, openvdb::Coord, int64_t>> all;
   for (size_t l = 0; l < impl_->last_use.size(); ++l)
     for (auto& [key, u] : impl_->last_use[l]) all.emplace_back(u.first, int(l), u.second, key);
   std::sort(all.begin(), all.end(), [](const auto& a, const auto& b) {
     return std::get<0>(a) < std::get<0>(b) || (std::get<0>(a) == std::get<0>(b) && std::get<3>(a) < std::get<3>(b));
   });
-  const int64_t target = budget_ * 9 / 10;
+  const int64_t target = budget * 9 / 10;
   for (const auto& [t, l, origin, key] : all) {
     if (leaves * impl_->leaf_bytes <= target) break;
     auto& tree = impl_->grids[size_t(l)]->tree();

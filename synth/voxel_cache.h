@@ -8,6 +8,7 @@
 // Only voxel_cache.cpp includes OpenVDB.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -39,12 +40,14 @@ class VoxelCache {
   void insert(PyramidLevel level, const std::vector<Voxel>& voxels, const std::vector<CoordinateTriple>& triples);
   void clear();
   Counters counters() const;
-  int64_t budget_bytes() const { return budget_; }
+  int64_t budget_bytes() const { return budget_.load(); }
+  // Changes the budget; takes effect (evicting if needed) at the next insert.
+  void set_budget_bytes(int64_t bytes) { budget_.store(bytes); }
 
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
-  int64_t budget_;
+  std::atomic<int64_t> budget_;
 };
 
 }  // namespace solidtex

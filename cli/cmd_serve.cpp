@@ -1,0 +1,45 @@
+// solidtex serve [--host 127.0.0.1] [--port 8080] [--data DIR] [--threads N] [--io-threads N]
+//   [--queue N] [--deadline S] [--max-deadline S] [--cache-mb M] [--max-upload-mb M]
+//   [--max-image-side PX] [--max-image-pixels N] [--max-voxels N] [--max-field-nodes N]
+//   [--max-jobs N] [--analysis-threads N]
+#include "args.h"
+#include "commands.h"
+#include "http_server.h"
+
+namespace solidtex::cli {
+
+Status run_serve(const std::vector<std::string>& argv) {
+  Args args({"--host", "--port", "--data", "--threads", "--io-threads", "--queue", "--deadline", "--max-deadline",
+             "--cache-mb", "--max-upload-mb", "--max-image-side", "--max-image-pixels", "--max-voxels",
+             "--max-field-nodes", "--max-jobs", "--analysis-threads"},
+            {});
+  SOLIDTEX_RETURN_IF_ERROR(args.parse(argv));
+  if (!args.positionals().empty())
+    return Status(StatusCode::kInvalidArgument, "takes no positional arguments", args.positionals()[0]);
+  server::ServerConfig c;
+  c.host = args.get("--host").value_or(c.host);
+  SOLIDTEX_ASSIGN_OR_RETURN(c.port, args.get_int("--port", c.port, 1, 65535));
+  c.data_dir = args.get("--data").value_or(c.data_dir);
+  SOLIDTEX_ASSIGN_OR_RETURN(c.threads, args.get_int("--threads", c.threads, 1, 256));
+  SOLIDTEX_ASSIGN_OR_RETURN(c.io_threads, args.get_int("--io-threads", c.io_threads, 1, 64));
+  SOLIDTEX_ASSIGN_OR_RETURN(c.queue, args.get_int("--queue", c.queue, 0, 10000));
+  SOLIDTEX_ASSIGN_OR_RETURN(c.max_deadline_s, args.get_double("--max-deadline", c.max_deadline_s, 0.001, 3600));
+  SOLIDTEX_ASSIGN_OR_RETURN(c.deadline_s, args.get_double("--deadline", c.deadline_s, 0.001, c.max_deadline_s));
+  SOLIDTEX_ASSIGN_OR_RETURN(int cache_mb, args.get_int("--cache-mb", int(c.cache_bytes >> 20), 0, 1 << 20));
+  c.cache_bytes = int64_t(cache_mb) << 20;
+  SOLIDTEX_ASSIGN_OR_RETURN(int upload_mb, args.get_int("--max-upload-mb", int(c.max_upload_bytes >> 20), 1, 4096));
+  c.max_upload_bytes = int64_t(upload_mb) << 20;
+  c.image_limits.max_bytes = c.max_upload_bytes;
+  SOLIDTEX_ASSIGN_OR_RETURN(c.image_limits.max_side, args.get_int("--max-image-side", c.image_limits.max_side, 8, 65536));
+  SOLIDTEX_ASSIGN_OR_RETURN(double pixels, args.get_double("--max-image-pixels", double(c.image_limits.max_pixels), 64, 4294967296.0));
+  c.image_limits.max_pixels = int64_t(pixels);
+  SOLIDTEX_ASSIGN_OR_RETURN(double voxels, args.get_double("--max-voxels", double(c.max_voxels), 1, double(int64_t(1) << 24)));
+  c.max_voxels = int64_t(voxels);
+  SOLIDTEX_ASSIGN_OR_RETURN(double nodes, args.get_double("--max-field-nodes", double(c.max_field_nodes), 8, double(int64_t(1) << 24)));
+  c.max_field_nodes = int64_t(nodes);
+  SOLIDTEX_ASSIGN_OR_RETURN(c.max_jobs, args.get_int("--max-jobs", c.max_jobs, 1, 1000));
+  SOLIDTEX_ASSIGN_OR_RETURN(c.analysis_threads, args.get_int("--analysis-threads", c.analysis_threads, 1, 16));
+  return server::run_server(c);
+}
+
+}  // namespace solidtex::cli

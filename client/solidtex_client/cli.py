@@ -1,0 +1,195 @@
+"""``solidtex-client``: command-line access to a solidtex service.
+
+    solidtex-client [--url URL] upload IMAGE [--yz IMG --zx IMG --mask IMG] [--levels L ...] [--wait]
+    solidtex-client field SKETCH.json
+    solidtex-client volume --exemplar ID [--field-id ID | --field-spec SPEC] [--seed S] [--scheme S]
+    solidtex-client slice VOLUME --axis z --at K --size W,H [--origin U,V] -o OUT.png
+    solidtex-client region VOLUME --min X,Y,Z --size W,H,D -o OUT.vdb|OUT.npy
+    solidtex-client points VOLUME POINTS.npy|POINTS.txt -o OUT.npy|OUT.txt
+
+JSON answers go to stdout. Errors print ``error: <code>: <message> (field)`` on stderr and
+exit with status 1. Coordinates and sizes are finest voxels, timeouts seconds.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+from typing import Any, List, Optional, Sequence
+
+import numpy as np
+import requests
+
+from .client import Client
+from .errors import SolidtexError
+
+
+def _ints(n: int):
+    def parse(text: str) -> List[int]:
+        try:
+            values = [int(s) for s in text.split(",")]
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected {n} comma-separated integers, got {text!r}")
+        if len(values) != n:
+            raise argparse.ArgumentTypeError(f"expected {n} comma-separated integers, got {text!r}")
+        return values
+    return parse
+
+
+def _floats(n: int):
+    def parse(text: str) -> List[float]:
+        try:
+            values = [float(s) for s in text.split(",")]
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected {n} comma-separated numbers, got {text!r}")
+        if len(values) != n:
+            raise argparse.ArgumentTypeError(f"expected {n} comma-separated numbers, got {text!r}")
+        return values
+    return parse
+
+
+def _print_json(value: Any) -> None:
+    print(json.dumps(value, indent=2, sort_keys=True))
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="solidtex-client", description=__doc__.split("\n")[0])
+    p.add_argument("--url", default=os.environ.get("SOLIDTEX_URL", "http://127.0.0.1:8080"),
+                   help="service base URL (default $SOLIDTEX_URL or http://127.0.0.1:8080)")
+    p.add_argument("--http-timeout", type=float, default=120.0, help="HTTP timeout, seconds")
+    sub = p.add_subparsers(dest="command", required=True)
+
+    up = sub.add_parser("upload", help="upload an exemplar and start its analysis")
+    up.add_argument("image")
+    up.add_argument("--yz")
+    up.add_argument("--zx")
+    up.add_argument("--mask")
+    up.add_argument("--name")
+    up.add_argument("--levels", type=int)
+    up.add_argument("--neighborhood", type=int)
+    up.add_argument("--candidates", type=int)
+    up.add_argument("--pca-dims", type=int)
+    up.add_argument("--seed", type=int)
+    up.add_argument("--plane-weights", type=_floats(3), metavar="A,B,C")
+    up.add_argument("--wait", action="store_true", help="wait for the analysis to finish")
+    up.add_argument("--wait-timeout", type=float, default=600.0, help="seconds")
+
+    fi = sub.add_parser("field", help="solve a frame field from a sketch JSON file")
+    fi.add_argument("sketch")
+    fi.add_argument("--timeout", type=float, help="server deadline, seconds")
+
+    vo = sub.add_parser("volume", help="create a volume")
+    vo.add_argument("--exemplar", required=True)
+    group = vo.add_mutually_exclusive_group()
+    group.add_argument("--field-id")
+    group.add_argument("--field-spec", help="identity | quat:W,X,Y,Z | axis:X,Y,Z,DEG [;scale:SX,SY,SZ]")
+    vo.add_argument("--seed", type=int)
+    vo.add_argument("--name")
+    vo.add_argument("--scheme", choices=["standard", "subpass", "grid", "dual-grid"])
+    vo.add_argument("--matcher", choices=["paper", "coherent"])
+
+    sl = sub.add_parser("slice", help="axis-aligned cut to a PNG")
+    sl.add_argument("volume")
+    sl.add_argument("--axis", required=True, choices=["x", "y", "z"])
+    sl.add_argument("--at", required=True, type=int)
+    sl.add_argument("--size", required=True, type=_ints(2), metavar="W,H")
+    sl.add_argument("--origin", type=_ints(2), default=[0, 0], metavar="U,V")
+    sl.add_argument("--timeout", type=float, help="server deadline, seconds")
+    sl.add_argument("-o", "--output", required=True)
+
+    rg = sub.add_parser("region", help="a box of voxels to .vdb (or .npy, D x H x W x 3)")
+    rg.add_argument("volume")
+    rg.add_argument("--min", required=True, type=_ints(3), metavar="X,Y,Z")
+    rg.add_argument("--size", required=True, type=_ints(3), metavar="W,H,D")
+    rg.add_argument("--dtype", choices=["float32", "uint8"], default="float32",
+                    help=".npy output: linear float32 (default) or sRGB uint8")
+    rg.add_argument("--timeout", type=float, help="server deadline, seconds")
+    rg.add_argument("-o", "--output", required=True)
+
+    pt = sub.add_parser("points", help="linear RGB at world points")
+    pt.add_argument("volume")
+    pt.add_argument("points", help=".npy (N x 3) or text, one 'x y z' (or x,y,z) per line")
+    pt.add_argument("--timeout", type=float, help="server deadline, seconds")
+    pt.add_argument("-o", "--output", required=True, help=".npy or .txt")
+    return p
+
+
+def _load_points(path: str) -> np.ndarray:
+    if path.endswith(".npy"):
+        pts = np.load(path)
+    else:
+        with open(path) as f:
+            rows = [line.replace(",", " ").split() for line in f]
+        pts = np.array([[float(x) for x in row] for row in rows if row], dtype=np.float64)
+    pts = np.asarray(pts, dtype=np.float64)
+    if pts.ndim != 2 or pts.shape[1] != 3:
+        raise ValueError(f"{path}: points must be N x 3, got shape {pts.shape}")
+    return pts
+
+
+def _run(args: argparse.Namespace) -> None:
+    client = Client(args.url, timeout=args.http_timeout)
+    if args.command == "upload":
+        params = {"name": args.name, "levels": args.levels, "neighborhood": args.neighborhood,
+                  "candidates": args.candidates, "pca_dims": args.pca_dims, "seed": args.seed,
+                  "plane_weights": args.plane_weights}
+        out = client.upload_exemplar(args.image, yz=args.yz, zx=args.zx, mask=args.mask, **params)
+        if args.wait:
+            job = client.wait_for_job(out["job"]["id"], timeout=args.wait_timeout)
+            out = {"exemplar": client.get_exemplar(out["exemplar"]["id"]), "job": job}
+        _print_json(out)
+    elif args.command == "field":
+        with open(args.sketch) as f:
+            sketch = json.load(f)
+        _print_json(client.create_field(sketch, timeout=args.timeout))
+    elif args.command == "volume":
+        params = {k: v for k, v in (("scheme", args.scheme), ("matcher", args.matcher)) if v}
+        field: Optional[dict] = None
+        if args.field_id:
+            field = {"id": args.field_id}
+        elif args.field_spec:
+            field = {"spec": args.field_spec}
+        _print_json(client.create_volume(exemplar=args.exemplar, field=field,
+                                         params=params or None, seed=args.seed, name=args.name))
+    elif args.command == "slice":
+        png = client.slice(args.volume, args.axis, args.at, args.size, origin=args.origin,
+                           dtype="png_bytes", timeout=args.timeout)
+        with open(args.output, "wb") as f:
+            f.write(png)
+    elif args.command == "region":
+        if args.output.endswith(".npy"):
+            arr = client.region(args.volume, args.min, args.size, fmt=args.dtype,
+                                timeout=args.timeout)
+            np.save(args.output, arr)
+        else:
+            data = client.region(args.volume, args.min, args.size, fmt="vdb", timeout=args.timeout)
+            with open(args.output, "wb") as f:
+                f.write(data)
+    elif args.command == "points":
+        rgb = client.points(args.volume, _load_points(args.points), timeout=args.timeout)
+        if args.output.endswith(".txt"):
+            np.savetxt(args.output, rgb, fmt="%.9g")
+        else:
+            np.save(args.output, rgb)
+
+
+def main(argv: Optional[Sequence[str]] = None) -> int:
+    """Entry point; returns the process exit status (0, or 1 on any error)."""
+    args = _parser().parse_args(argv)
+    try:
+        _run(args)
+    except SolidtexError as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 1
+    except requests.RequestException as e:
+        print(f"error: connection: {e}", file=sys.stderr)
+        return 1
+    except (OSError, ValueError, TimeoutError) as e:
+        print(f"error: {type(e).__name__}: {e}", file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

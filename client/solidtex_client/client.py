@@ -1,0 +1,496 @@
+"""HTTP client for the solidtex service: one method per operation of proto/openapi.json.
+
+Units: world coordinates and sizes are finest-level voxels; timeouts and deadlines are
+seconds. Colours: ``uint8`` answers are sRGB-encoded 8-bit, ``float32`` answers are linear RGB.
+Every error answer raises the :mod:`solidtex_client.errors` exception for its status.
+"""
+from __future__ import annotations
+
+import io
+import json as _json
+import os
+import struct
+import time
+import zlib
+from urllib.parse import quote, urlencode
+from typing import Any, Dict, Iterable, List, Mapping, Optional, Sequence, Tuple, Union
+
+import numpy as np
+import requests
+
+from .errors import JobFailed, error_from_response
+
+ImageInput = Union[str, "os.PathLike[str]", bytes, bytearray, memoryview, np.ndarray, Any]
+
+_CUT_ACCEPT = {
+    "uint8": "application/octet-stream",
+    "float32": "application/octet-stream; dtype=float32",
+    "png": "image/png",
+    "png_bytes": "image/png",
+}
+_REGION_ACCEPT = {
+    "vdb": "application/x-vdb",
+    "uint8": "application/octet-stream",
+    "float32": "application/octet-stream; dtype=float32",
+}
+
+
+# ----------------------------------------------------------------------------------------
+# Image encoding
+
+
+def _png_chunk(kind: bytes, data: bytes) -> bytes:
+    return (struct.pack(">I", len(data)) + kind + data
+            + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF))
+
+
+def encode_png(array: np.ndarray) -> bytes:
+    """PNG bytes for an HxW, HxWx1, HxWx3 or HxWx4 array.
+
+    ``uint8`` gives an 8-bit PNG, ``uint16`` a 16-bit PNG (both lossless). Float arrays are
+    taken as display-referred values in [0, 1] (the same encoding as the integer PNGs, i.e.
+    sRGB-encoded, not linear): they are clipped and quantised to a 16-bit PNG. Other integer
+    types must lie in [0, 65535] and become 16-bit.
+    """
+    a = np.asarray(array)
+    if a.ndim == 3 and a.shape[2] == 1:
+        a = a[:, :, 0]
+    if a.ndim not in (2, 3) or (a.ndim == 3 and a.shape[2] not in (2, 3, 4)):
+        raise ValueError(f"image array must be HxW or HxWx1/2/3/4, got shape {a.shape}")
+    if a.shape[0] < 1 or a.shape[1] < 1:
+        raise ValueError("image array is empty")
+    if a.dtype == np.uint8:
+        depth, data = 8, a
+    elif a.dtype == np.uint16:
+        depth, data = 16, a
+    elif np.issubdtype(a.dtype, np.floating):
+        if not np.all(np.isfinite(a)):
+            raise ValueError("image array has NaN or infinite values")
+        depth, data = 16, np.round(np.clip(a, 0.0, 1.0) * 65535.0).astype(np.uint16)
+    elif np.issubdtype(a.dtype, np.integer) or a.dtype == np.bool_:
+        if a.min() < 0 or a.max() > 65535:
+            raise ValueError("integer image values must lie in [0, 65535]")
+        depth, data = 16, a.astype(np.uint16)
+    else:
+        raise ValueError(f"unsupported image dtype {a.dtype}")
+    h, w = data.shape[:2]
+    channels = 1 if data.ndim == 2 else data.shape[2]
+    color_type = {1: 0, 2: 4, 3: 2, 4: 6}[channels]
+    raw = np.ascontiguousarray(data.astype(">u2") if depth == 16 else data)
+    rows = raw.reshape(h, -1).view(np.uint8).reshape(h, -1)
+    scan = np.concatenate([np.zeros((h, 1), np.uint8), rows], axis=1).tobytes()  # filter 0
+    ihdr = struct.pack(">IIBBBBB", w, h, depth, color_type, 0, 0, 0)
+    return (b"\x89PNG\r\n\x1a\n" + _png_chunk(b"IHDR", ihdr)
+            + _png_chunk(b"IDAT", zlib.compress(scan, 6)) + _png_chunk(b"IEND", b""))
+
+
+def image_bytes(image: ImageInput) -> bytes:
+    """Encoded image bytes for an upload.
+
+    ``image`` may be a file path (sent as is: PNG, JPEG, TIFF or OpenEXR), encoded bytes
+    (sent as is), a ``PIL.Image.Image`` (encoded as PNG) or a numpy array (see
+    :func:`encode_png`).
+    """
+    if isinstance(image, (bytes, bytearray, memoryview)):
+        return bytes(image)
+    if isinstance(image, (str, os.PathLike)):
+        with open(image, "rb") as f:
+            return f.read()
+    if isinstance(image, np.ndarray):
+        return encode_png(image)
+    try:
+        from PIL import Image
+    except ImportError:  # pragma: no cover - Pillow is a dependency
+        Image = None  # type: ignore[assignment]
+    if Image is not None and isinstance(image, Image.Image):
+        img = image
+        if img.mode not in ("1", "L", "LA", "I", "I;16", "P", "RGB", "RGBA"):
+            img = img.convert("RGBA" if "A" in img.getbands() else "RGB")
+        buf = io.BytesIO()
+        img.save(buf, format="PNG")
+        return buf.getvalue()
+    raise TypeError(f"unsupported image type {type(image).__name__}: "
+                    "give a path, bytes, a PIL image or a numpy array")
+
+
+def _image_filename(part: str, data: bytes) -> Tuple[str, str]:
+    if data.startswith(b"\x89PNG"):
+        return part + ".png", "image/png"
+    if data.startswith(b"\xff\xd8"):
+        return part + ".jpg", "image/jpeg"
+    if data[:4] in (b"II*\x00", b"MM\x00*"):
+        return part + ".tif", "image/tiff"
+    if data.startswith(b"\x76\x2f\x31\x01"):
+        return part + ".exr", "image/x-exr"
+    return part, "application/octet-stream"
+
+
+# ----------------------------------------------------------------------------------------
+# Query helpers
+
+
+def _csv(values: Iterable[Any]) -> str:
+    return ",".join(_num(v) for v in values)
+
+
+def _num(v: Any) -> str:
+    if isinstance(v, (bool, np.bool_)):
+        return "true" if v else "false"
+    if isinstance(v, (int, np.integer)):
+        return str(int(v))
+    if isinstance(v, (float, np.floating)):
+        f = float(v)
+        return str(int(f)) if f.is_integer() and abs(f) < 1e15 else repr(f)
+    return str(v)
+
+
+def _query_value(v: Any) -> str:
+    if isinstance(v, (list, tuple, np.ndarray)):
+        return _csv(v)
+    return _num(v)
+
+
+def _shape(response: requests.Response, fallback: Optional[Sequence[int]] = None) -> Tuple[int, ...]:
+    header = response.headers.get("X-Shape")
+    if header:
+        return tuple(int(s) for s in header.split(","))
+    if fallback is None:
+        raise ValueError("raw answer without X-Shape header")
+    return tuple(fallback)
+
+
+def _raw_array(response: requests.Response, dtype: str,
+               fallback: Optional[Sequence[int]] = None) -> np.ndarray:
+    shape = _shape(response, fallback)
+    np_dtype = np.dtype("<f4") if dtype == "float32" else np.dtype(np.uint8)
+    data = response.content
+    expected = int(np.prod(shape)) * np_dtype.itemsize
+    if len(data) != expected:
+        raise ValueError(f"raw answer has {len(data)} bytes, X-Shape {shape} of {np_dtype} "
+                         f"needs {expected}")
+    arr = np.frombuffer(data, dtype=np_dtype).reshape(shape)
+    return arr.astype(np.float32) if dtype == "float32" else arr.copy()
+
+
+class Client:
+    """A solidtex service at ``base_url``; ``timeout`` is the HTTP timeout in seconds.
+
+    ``last_response`` holds the ``requests.Response`` of the latest call (headers such as
+    ``X-Voxels-Synthesized`` live there). One client may be used from one thread at a time.
+    """
+
+    def __init__(self, base_url: str = "http://127.0.0.1:8080", timeout: float = 60,
+                 session: Optional[requests.Session] = None) -> None:
+        self.base_url = base_url.rstrip("/")
+        self.timeout = timeout
+        self.session = session if session is not None else requests.Session()
+        self.last_response: Optional[requests.Response] = None
+
+    def __repr__(self) -> str:
+        return f"Client({self.base_url!r})"
+
+    def close(self) -> None:
+        self.session.close()
+
+    def __enter__(self) -> "Client":
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.close()
+
+    # -- transport ------------------------------------------------------------------------
+
+    def request(self, method: str, path: str, *, params: Optional[Mapping[str, Any]] = None,
+                headers: Optional[Mapping[str, str]] = None, json: Any = None,
+                data: Any = None, files: Any = None,
+                http_timeout: Optional[float] = None) -> requests.Response:
+        """One HTTP request; raises the typed error for a status >= 400."""
+        query = None
+        if params:
+            # Commas stay literal (they are legal in a query): size=32,24 rather than 32%2C24.
+            query = urlencode({k: _query_value(v) for k, v in params.items() if v is not None},
+                              quote_via=quote, safe=",") or None
+        body = data
+        hdrs = dict(headers or {})
+        if json is not None:
+            body = _json.dumps(json).encode()
+            hdrs.setdefault("Content-Type", "application/json")
+        response = self.session.request(method, self.base_url + path, params=query,
+                                        headers=hdrs, data=body, files=files,
+                                        timeout=http_timeout or self.timeout)
+        self.last_response = response
+        if response.status_code >= 400:
+            raise error_from_response(response)
+        return response
+
+    def _http_timeout(self, deadline: Optional[float]) -> float:
+        # Leave the server time to answer 504 itself before the socket gives up.
+        return max(self.timeout, (deadline or 0) + 10)
+
+    # -- service --------------------------------------------------------------------------
+
+    def healthz(self) -> Dict[str, Any]:
+        """GET /healthz: liveness JSON."""
+        return self.request("GET", "/healthz").json()
+
+    def metrics(self) -> str:
+        """GET /metrics: Prometheus text."""
+        return self.request("GET", "/metrics").text
+
+    def openapi(self) -> Dict[str, Any]:
+        """GET /v1/openapi.json: the API contract."""
+        return self.request("GET", "/v1/openapi.json").json()
+
+    # -- exemplars ------------------------------------------------------------------------
+
+    def list_exemplars(self) -> List[Dict[str, Any]]:
+        """GET /v1/exemplars: the exemplar objects."""
+        return self.request("GET", "/v1/exemplars").json()["exemplars"]
+
+    def upload_exemplar(self, image: ImageInput, yz: Optional[ImageInput] = None,
+                        zx: Optional[ImageInput] = None, mask: Optional[ImageInput] = None,
+                        **analysis_params: Any) -> Dict[str, Any]:
+        """POST /v1/exemplars: upload an exemplar; its analysis runs in the background.
+
+        ``image`` (and ``yz``, ``zx``, ``mask``) is a path, encoded bytes, a PIL image or a
+        numpy array (arrays are sent as PNG, see :func:`encode_png`). One image alone is
+        sent as the raw body (``application/octet-stream``); with ``yz``/``zx``/``mask`` the
+        body is multipart/form-data with parts ``xy``, ``yz``, ``zx``, ``mask``.
+        ``analysis_params`` go in the query: ``name``, ``levels``, ``neighborhood`` (odd
+        template size in pixels), ``candidates``, ``pca_dims``, ``seed``, ``plane_weights``
+        (a 3-sequence or ``"a,b,c"``). Returns ``{"exemplar": ..., "job": ...}``.
+        """
+        params = {k: v for k, v in analysis_params.items() if v is not None}
+        xy = image_bytes(image)
+        extra = {"yz": yz, "zx": zx, "mask": mask}
+        if all(v is None for v in extra.values()):
+            r = self.request("POST", "/v1/exemplars", params=params, data=xy,
+                             headers={"Content-Type": "application/octet-stream"})
+            return r.json()
+        files = []
+        for part, value in (("xy", image), *extra.items()):
+            if value is None:
+                continue
+            data = xy if part == "xy" else image_bytes(value)
+            name, mime = _image_filename(part, data)
+            files.append((part, (name, data, mime)))
+        return self.request("POST", "/v1/exemplars", params=params, files=files).json()
+
+    def get_exemplar(self, exemplar_id: str) -> Dict[str, Any]:
+        """GET /v1/exemplars/{id}."""
+        return self.request("GET", f"/v1/exemplars/{exemplar_id}").json()
+
+    def delete_exemplar(self, exemplar_id: str) -> None:
+        """DELETE /v1/exemplars/{id} (409 while a volume uses it)."""
+        self.request("DELETE", f"/v1/exemplars/{exemplar_id}")
+
+    def get_exemplar_table(self, exemplar_id: str) -> bytes:
+        """GET /v1/exemplars/{id}/table: the .stx file bytes."""
+        return self.request("GET", f"/v1/exemplars/{exemplar_id}/table").content
+
+    # -- jobs -----------------------------------------------------------------------------
+
+    def get_job(self, job_id: str) -> Dict[str, Any]:
+        """GET /v1/jobs/{id}: state (queued, running, succeeded, failed) and percent."""
+        return self.request("GET", f"/v1/jobs/{job_id}").json()
+
+    def wait_for_job(self, job_id: str, timeout: float = 120, poll: float = 0.2) -> Dict[str, Any]:
+        """Poll a job every ``poll`` seconds until it succeeds; returns the final job.
+
+        Raises :class:`~solidtex_client.errors.JobFailed` if it fails and ``TimeoutError``
+        if it has not finished after ``timeout`` seconds.
+        """
+        end = time.monotonic() + timeout
+        while True:
+            job = self.get_job(job_id)
+            if job.get("state") == "succeeded":
+                return job
+            if job.get("state") == "failed":
+                raise JobFailed(job)
+            if time.monotonic() >= end:
+                raise TimeoutError(f"job {job_id} still {job.get('state')} "
+                                   f"({job.get('percent')}%) after {timeout} s")
+            time.sleep(poll)
+
+    # -- fields ---------------------------------------------------------------------------
+
+    def list_fields(self) -> List[Dict[str, Any]]:
+        """GET /v1/fields: the field objects."""
+        return self.request("GET", "/v1/fields").json()["fields"]
+
+    def create_field(self, sketch: Mapping[str, Any], timeout: Optional[float] = None) -> Dict[str, Any]:
+        """POST /v1/fields: solve a frame field from a sketch (sketch.schema.json).
+
+        ``timeout`` is the server-side deadline in seconds.
+        """
+        return self.request("POST", "/v1/fields", json=dict(sketch), params={"timeout": timeout},
+                            http_timeout=self._http_timeout(timeout)).json()
+
+    def get_field(self, field_id: str) -> Dict[str, Any]:
+        """GET /v1/fields/{id}."""
+        return self.request("GET", f"/v1/fields/{field_id}").json()
+
+    def delete_field(self, field_id: str) -> None:
+        """DELETE /v1/fields/{id} (volumes keep their own copies)."""
+        self.request("DELETE", f"/v1/fields/{field_id}")
+
+    def get_field_file(self, field_id: str) -> bytes:
+        """GET /v1/fields/{id}/file: the .stf bytes of the current revision."""
+        return self.request("GET", f"/v1/fields/{field_id}/file").content
+
+    def add_curve(self, field_id: str, curve: Mapping[str, Any],
+                  timeout: Optional[float] = None) -> Dict[str, Any]:
+        """POST /v1/fields/{id}/curves: add one sketch curve and re-solve (revision + 1)."""
+        return self.request("POST", f"/v1/fields/{field_id}/curves", json=dict(curve),
+                            params={"timeout": timeout},
+                            http_timeout=self._http_timeout(timeout)).json()
+
+    def sample_frames(self, field_id: str, min: Sequence[float], size: Sequence[int],
+                      step: float = 1.0) -> Dict[str, Any]:
+        """GET /v1/fields/{id}/frames: frames on a grid of ``size`` = (NX, NY, NZ) points
+        starting at world point ``min`` and ``step`` world units apart.
+
+        Returns the answer with ``points`` (N, 3), ``quaternions`` (N, 4; w, x, y, z) and
+        ``scales`` (N, 3) as float64 numpy arrays.
+        """
+        out = self.request("GET", f"/v1/fields/{field_id}/frames",
+                           params={"min": list(min), "size": list(size), "step": step}).json()
+        for key, width in (("points", 3), ("quaternions", 4), ("scales", 3)):
+            if key in out:
+                out[key] = np.asarray(out[key], dtype=np.float64).reshape(-1, width)
+        return out
+
+    # -- volumes --------------------------------------------------------------------------
+
+    def list_volumes(self) -> List[Dict[str, Any]]:
+        """GET /v1/volumes: the volume objects."""
+        return self.request("GET", "/v1/volumes").json()["volumes"]
+
+    def create_volume(self, spec: Optional[Mapping[str, Any]] = None, *,
+                      exemplar: Optional[str] = None,
+                      field: Union[None, str, Mapping[str, Any]] = None,
+                      params: Optional[Mapping[str, Any]] = None, seed: Optional[int] = None,
+                      regions: Union[None, Mapping[str, Any], Tuple[Sequence[str], str]] = None,
+                      name: Optional[str] = None) -> Dict[str, Any]:
+        """POST /v1/volumes with a volume.schema.json body.
+
+        Give the whole ``spec`` dict, or build it from keywords: ``exemplar`` (id),
+        ``regions`` (a dict, or ``((id0, id1), label)``), ``field`` (a dict ``{"id": ...}``
+        / ``{"spec": ...}``, or a string: ``identity``, ``quat:...`` and ``axis:...``
+        strings are specs, anything else is a stored field id), ``params`` (synthesis
+        parameters), ``seed``, ``name``. Keywords override keys of ``spec``.
+        """
+        body: Dict[str, Any] = dict(spec or {})
+        if exemplar is not None:
+            body["exemplar"] = exemplar
+        if regions is not None:
+            if isinstance(regions, Mapping):
+                body["regions"] = dict(regions)
+            else:
+                ids, label = regions
+                body["regions"] = {"exemplars": list(ids), "label": label}
+        if field is not None:
+            if isinstance(field, str):
+                is_spec = field.split(";")[0] == "identity" or field.startswith(("quat:", "axis:"))
+                body["field"] = {"spec": field} if is_spec else {"id": field}
+            else:
+                body["field"] = dict(field)
+        if params is not None:
+            body["params"] = dict(params)
+        if seed is not None:
+            body["seed"] = int(seed)
+        if name is not None:
+            body["name"] = name
+        return self.request("POST", "/v1/volumes", json=body).json()
+
+    def get_volume(self, volume_id: str) -> Dict[str, Any]:
+        """GET /v1/volumes/{id}."""
+        return self.request("GET", f"/v1/volumes/{volume_id}").json()
+
+    def delete_volume(self, volume_id: str) -> None:
+        """DELETE /v1/volumes/{id}."""
+        self.request("DELETE", f"/v1/volumes/{volume_id}")
+
+    def volume_stats(self, volume_id: str) -> Dict[str, Any]:
+        """GET /v1/volumes/{id}/stats: voxels per level, cache bytes and hits, recent requests."""
+        return self.request("GET", f"/v1/volumes/{volume_id}/stats").json()
+
+    def _cut_answer(self, response: requests.Response, dtype: str) -> Any:
+        if dtype == "png_bytes":
+            return response.content
+        if dtype == "png":
+            from PIL import Image
+            img = Image.open(io.BytesIO(response.content))
+            img.load()
+            return img
+        return _raw_array(response, dtype)
+
+    def slice(self, volume_id: str, axis: str, at: int, size: Sequence[int],
+              origin: Sequence[int] = (0, 0), dtype: str = "uint8",
+              timeout: Optional[float] = None) -> Any:
+        """GET /v1/volumes/{id}/slice: an axis-aligned cut of ``size`` = (W, H) pixels.
+
+        Pixel (i, j) is finest voxel (U+i, V+j, at) for axis z, (at, U+i, V+j) for x,
+        (U+i, at, V+j) for y, with ``origin`` = (U, V). ``dtype``: ``"uint8"`` -> sRGB
+        uint8 array (H, W, 3); ``"float32"`` -> linear float32 array (H, W, 3); ``"png"`` ->
+        ``PIL.Image``; ``"png_bytes"`` -> the PNG bytes as sent. ``timeout`` is the
+        server-side deadline in seconds (504 past it).
+        """
+        if dtype not in _CUT_ACCEPT:
+            raise ValueError(f"dtype must be one of {sorted(_CUT_ACCEPT)}")
+        params = {"axis": axis, "at": int(at), "origin": list(origin), "size": list(size),
+                  "timeout": timeout}
+        r = self.request("GET", f"/v1/volumes/{volume_id}/slice", params=params,
+                         headers={"Accept": _CUT_ACCEPT[dtype]},
+                         http_timeout=self._http_timeout(timeout))
+        return self._cut_answer(r, dtype)
+
+    def cut(self, volume_id: str, origin: Sequence[float], u: Sequence[float],
+            v: Sequence[float], size: Sequence[int], dtype: str = "uint8",
+            timeout: Optional[float] = None) -> Any:
+        """POST /v1/volumes/{id}/cut: a planar cut; pixel (i, j) is the voxel nearest
+        ``origin + i*u + j*v`` (world units = finest voxels), ``size`` = (W, H).
+
+        ``dtype`` and ``timeout`` as for :meth:`slice`.
+        """
+        if dtype not in _CUT_ACCEPT:
+            raise ValueError(f"dtype must be one of {sorted(_CUT_ACCEPT)}")
+        body = {"origin": [float(x) for x in origin], "u": [float(x) for x in u],
+                "v": [float(x) for x in v], "size": [int(x) for x in size]}
+        r = self.request("POST", f"/v1/volumes/{volume_id}/cut", json=body,
+                         params={"timeout": timeout}, headers={"Accept": _CUT_ACCEPT[dtype]},
+                         http_timeout=self._http_timeout(timeout))
+        return self._cut_answer(r, dtype)
+
+    def region(self, volume_id: str, min: Sequence[int], size: Sequence[int],
+               fmt: str = "vdb", timeout: Optional[float] = None) -> Any:
+        """GET /v1/volumes/{id}/region: the box of ``size`` = (W, H, D) voxels at ``min`` =
+        (X, Y, Z).
+
+        ``fmt``: ``"vdb"`` -> bytes of an OpenVDB file (Vec3s grid 'color', linear RGB);
+        ``"uint8"`` -> sRGB uint8 array (D, H, W, 3); ``"float32"`` -> linear float32 array
+        (D, H, W, 3). Index ``[z, y, x]`` is voxel ``min + (x, y, z)``.
+        """
+        if fmt not in _REGION_ACCEPT:
+            raise ValueError(f"fmt must be one of {sorted(_REGION_ACCEPT)}")
+        r = self.request("GET", f"/v1/volumes/{volume_id}/region",
+                         params={"min": list(min), "size": list(size), "timeout": timeout},
+                         headers={"Accept": _REGION_ACCEPT[fmt]},
+                         http_timeout=self._http_timeout(timeout))
+        if fmt == "vdb":
+            return r.content
+        w, h, d = (int(s) for s in size)
+        return _raw_array(r, fmt, fallback=(d, h, w, 3))
+
+    def points(self, volume_id: str, xyz: Any, timeout: Optional[float] = None) -> np.ndarray:
+        """POST /v1/volumes/{id}/points: linear RGB float32 (N, 3) at world points ``xyz``
+        (N, 3), each rounded to its nearest finest voxel (voxel (i, j, k) is at (i, j, k)).
+        """
+        pts = np.asarray(xyz, dtype=np.float64).reshape(-1, 3)
+        body = pts.astype("<f4").tobytes()
+        r = self.request("POST", f"/v1/volumes/{volume_id}/points", data=body,
+                         params={"timeout": timeout},
+                         headers={"Content-Type": "application/octet-stream",
+                                  "Accept": "application/octet-stream"},
+                         http_timeout=self._http_timeout(timeout))
+        return _raw_array(r, "float32", fallback=(len(pts), 3))

@@ -1,0 +1,434 @@
+#include "api.h"
+
+#include <cstring>
+
+#include "http_errors.h"
+#include "image_io.h"
+#include "json_fields.h"
+#include "openapi_document.h"
+#include "query_params.h"
+#include "vdb_export.h"
+
+namespace solidtex::server {
+
+using nlohmann::json;
+
+HttpResponse HttpResponse::json(int status, const nlohmann::json& j) {
+  HttpResponse r;
+  r.status = status;
+  r.body = j.dump();
+  return r;
+}
+
+HttpResponse HttpResponse::error(const Status& s) {
+  HttpResponse r;
+  r.status = http_status_for(s.code());
+  r.body = error_body(s);
+  return r;
+}
+
+namespace {
+
+enum class Encoding { kPng, kVdb, kRgb8, kFloat32, kJson };
+
+// Raw answers are asked for with Accept: application/octet-stream[; dtype=float32].
+Encoding negotiate(const std::string& accept, Encoding fallback) {
+  if (accept.find("application/octet-stream") != std::string::npos)
+    return accept.find("dtype=float32") != std::string::npos ? Encoding::kFloat32 : Encoding::kRgb8;
+  if (accept.find("application/json") != std::string::npos && fallback == Encoding::kFloat32) return Encoding::kJson;
+  return fallback;
+}
+
+Status require_json_body(const HttpRequest& r) {
+  if (!r.content_type.empty() && r.content_type != "application/json")
+    return Status(StatusCode::kUnsupported, "expected Content-Type application/json, got " + r.content_type, "Content-Type");
+  return Status::ok();
+}
+
+std::string floats_to_bytes(const std::vector<std::array<float, 3>>& rgb) {
+  std::string out(rgb.size() * 12, '\0');
+  for (size_t i = 0; i < rgb.size(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      const uint32_t u = std::bit_cast<uint32_t>(rgb[i][size_t(c)]);
+      for (int b = 0; b < 4; ++b) out[i * 12 + size_t(c) * 4 + size_t(b)] = char((u >> (8 * b)) & 0xff);
+    }
+  return out;
+}
+
+ImageF to_image(const std::vector<std::array<float, 3>>& rgb, int width, int height) {
+  ImageF img(width, height, 3);
+  for (size_t i = 0; i < rgb.size(); ++i)
+    for (int c = 0; c < 3; ++c) img.pixels[i * 3 + size_t(c)] = rgb[i][size_t(c)];
+  return img;
+}
+
+// Encodes colours laid out as `shape` (outermost first, last = 3) in the negotiated form.
+Result<HttpResponse> encode_colours(const std::vector<std::array<float, 3>>& rgb, int width, int height,
+                                    const std::string& shape, Encoding enc) {
+  HttpResponse out;
+  switch (enc) {
+    case Encoding::kPng: {
+      SOLIDTEX_ASSIGN_OR_RETURN(auto png, encode_png_srgb8(to_image(rgb, width, height)));
+      out.content_type = "image/png";
+      out.body.assign(png.begin(), png.end());
+      return out;
+    }
+    case Encoding::kRgb8: {
+      const std::vector<uint8_t> px = to_srgb8(to_image(rgb, width, height));
+      out.content_type = "application/octet-stream";
+      out.body.assign(px.begin(), px.end());
+      out.headers.push_back({"X-Dtype", "uint8"});
+      out.headers.push_back({"X-Shape", shape});
+      return out;
+    }
+    case Encoding::kFloat32:
+      out.content_type = "application/octet-stream";
+      out.body = floats_to_bytes(rgb);
+      out.headers.push_back({"X-Dtype", "float32"});
+      out.headers.push_back({"X-Shape", shape});
+      return out;
+    case Encoding::kJson: {
+      json a = json::array();
+      for (const auto& c : rgb) a.push_back({c[0], c[1], c[2]});
+      out.body = json{{"rgb", a}}.dump();
+      return out;
+    }
+    case Encoding::kVdb: break;
+  }
+  return Status(StatusCode::kInternal, "unexpected encoding");
+}
+
+template <typename F>
+HttpResponse respond(int ok_status, F&& f) {
+  auto r = f();
+  if (!r) return HttpResponse::error(r.status());
+  return HttpResponse::json(ok_status, *r);
+}
+
+HttpResponse respond_status(const Status& s) {
+  if (!s.is_ok()) return HttpResponse::error(s);
+  HttpResponse r;
+  r.status = 204;
+  r.content_type.clear();
+  return r;
+}
+
+HttpResponse respond_bytes(Result<std::vector<uint8_t>> bytes) {
+  if (!bytes) return HttpResponse::error(bytes.status());
+  HttpResponse r;
+  r.content_type = "application/octet-stream";
+  r.body.assign(bytes->begin(), bytes->end());
+  return r;
+}
+
+Status no_query(const HttpRequest& r) { return QueryParams::parse(r.query, {}).status(); }
+
+}  // namespace
+
+Api::Api(const ServerConfig& config, ExemplarService& exemplars, FieldService& fields, VolumeService& volumes,
+         Metrics& metrics, const WorkerPool& pool, const std::atomic<bool>& shutting_down)
+    : config_(config), exemplars_(exemplars), fields_(fields), volumes_(volumes), metrics_(metrics), pool_(pool),
+      shutting_down_(shutting_down) {}
+
+Result<std::unique_ptr<RequestInterrupter>> Api::interrupter_for(const HttpRequest& r, const std::string& timeout) const {
+  double seconds = config_.deadline_s;
+  if (!timeout.empty()) {
+    QueryParams q;
+    SOLIDTEX_ASSIGN_OR_RETURN(q, QueryParams::parse({{"timeout", timeout}}, {"timeout"}));
+    SOLIDTEX_ASSIGN_OR_RETURN(seconds, q.get_double("timeout", config_.deadline_s, 0.001, config_.max_deadline_s));
+  }
+  const auto deadline = r.arrival + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
+  return std::make_unique<RequestInterrupter>(deadline, r.disconnected, &shutting_down_);
+}
+
+HttpResponse Api::healthz(const HttpRequest& r) {
+  if (Status s = no_query(r); !s.is_ok()) return HttpResponse::error(s);
+  return HttpResponse::json(200, {{"status", shutting_down_.load() ? "stopping" : "ok"},
+                                  {"queue_depth", pool_.queued()},
+                                  {"workers_busy", pool_.running()}});
+}
+
+HttpResponse Api::metrics(const HttpRequest&) {
+  MetricGauges g;
+  g.queue_depth = pool_.queued();
+  g.workers_busy = pool_.running();
+  g.queue_capacity = pool_.capacity();
+  g.cache_bytes = volumes_.cache_bytes();
+  g.voxels_synthesized = volumes_.voxels_synthesized();
+  g.analysis_jobs = exemplars_.jobs_pending();
+  HttpResponse out;
+  out.content_type = "text/plain; version=0.0.4";
+  out.body = metrics_.render(g);
+  return out;
+}
+
+HttpResponse Api::openapi(const HttpRequest&) {
+  HttpResponse out;
+  out.body = openapi_document();
+  return out;
+}
+
+HttpResponse Api::list_exemplars(const HttpRequest& r) {
+  if (Status s = no_query(r); !s.is_ok()) return HttpResponse::error(s);
+  return HttpResponse::json(200, exemplars_.list());
+}
+
+HttpResponse Api::upload_exemplar(const HttpRequest& r) {
+  auto result = [&]() -> Result<HttpResponse> {
+    SOLIDTEX_ASSIGN_OR_RETURN(QueryParams q, QueryParams::parse(r.query, {"name", "levels", "neighborhood", "candidates",
+                                                                          "pca_dims", "seed", "plane_weights", "grain",
+                                                                          "mask_weight"}));
+    ExemplarUpload up;
+    up.name = q.get("name").value_or("");
+    if (up.name.size() > 200) return Status(StatusCode::kInvalidArgument, "is longer than 200 characters", "name");
+    SOLIDTEX_ASSIGN_OR_RETURN(up.params.levels, q.get_int("levels", up.params.levels, 1, 8));
+    SOLIDTEX_ASSIGN_OR_RETURN(up.params.neighborhood, q.get_int("neighborhood", up.params.neighborhood, 3, 15));
+    SOLIDTEX_ASSIGN_OR_RETURN(up.params.candidates, q.get_int("candidates", up.params.candidates, 1, 32));
+    SOLIDTEX_ASSIGN_OR_RETURN(up.params.pca_dims, q.get_int("pca_dims", up.params.pca_dims, 1, 64));
+    SOLIDTEX_ASSIGN_OR_RETURN(auto seed, q.get_int("seed", 1, 0, 1 << 30));
+    up.params.seed = uint32_t(seed);
+    if (q.has("plane_weights")) {
+      SOLIDTEX_ASSIGN_OR_RETURN(auto w, q.get_list("plane_weights", 3));
+      up.params.suggested_plane_weights = {float(w[0]), float(w[1]), float(w[2])};
+    }
+    up.grain = q.get("grain").value_or("");
+    SOLIDTEX_ASSIGN_OR_RETURN(double mw, q.get_double("mask_weight", 1.0, 0.0, 10.0));
+    up.mask_weight = float(mw);
+    if (r.multipart) {
+      for (const auto& [name, bytes] : r.parts) {
+        for (const auto& [seen, unused] : up.parts)
+          if (seen == name || (seen == "xy" && name == "image") || (seen == "image" && name == "xy"))
+            return Status(StatusCode::kInvalidArgument, "part given more than once", name);
+        up.parts.emplace_back(name, std::vector<uint8_t>(bytes.begin(), bytes.end()));
+      }
+    } else {
+      if (r.content_type == "application/json" || r.content_type == "application/x-www-form-urlencoded")
+        return Status(StatusCode::kUnsupported,
+                      "send the image bytes (e.g. application/octet-stream or image/png) or multipart/form-data",
+                      "Content-Type");
+      up.parts.emplace_back("xy", std::vector<uint8_t>(r.body.begin(), r.body.end()));
+    }
+    SOLIDTEX_ASSIGN_OR_RETURN(json created, exemplars_.upload(std::move(up)));
+    HttpResponse out = HttpResponse::json(202, created);
+    out.headers.push_back({"Location", "/v1/jobs/" + created["job"]["id"].get<std::string>()});
+    return out;
+  }();
+  return result ? *result : HttpResponse::error(result.status());
+}
+
+HttpResponse Api::get_exemplar(const HttpRequest& r) { return respond(200, [&] { return exemplars_.get(r.param("id")); }); }
+
+HttpResponse Api::delete_exemplar(const HttpRequest& r) {
+  return respond_status(exemplars_.remove(r.param("id"), [&](const std::string& id) { return volumes_.uses_exemplar(id); }));
+}
+
+HttpResponse Api::get_exemplar_table(const HttpRequest& r) { return respond_bytes(exemplars_.table_bytes(r.param("id"))); }
+
+HttpResponse Api::get_job(const HttpRequest& r) { return respond(200, [&] { return exemplars_.job(r.param("id")); }); }
+
+HttpResponse Api::list_fields(const HttpRequest& r) {
+  if (Status s = no_query(r); !s.is_ok()) return HttpResponse::error(s);
+  return HttpResponse::json(200, fields_.list());
+}
+
+HttpResponse Api::create_field(const HttpRequest& r) {
+  auto result = [&]() -> Result<HttpResponse> {
+    SOLIDTEX_ASSIGN_OR_RETURN(QueryParams q, QueryParams::parse(r.query, {"timeout"}));
+    SOLIDTEX_RETURN_IF_ERROR(require_json_body(r));
+    SOLIDTEX_ASSIGN_OR_RETURN(auto interrupter, interrupter_for(r, q.get("timeout").value_or("")));
+    auto created = fields_.create(r.body, *interrupter);
+    if (!created && created.status().code() == StatusCode::kCancelled) return interrupter->interruption_status("the field solve");
+    if (!created) return created.status();
+    HttpResponse out = HttpResponse::json(201, *created);
+    out.headers.push_back({"Location", "/v1/fields/" + (*created)["id"].get<std::string>()});
+    return out;
+  }();
+  return result ? *result : HttpResponse::error(result.status());
+}
+
+HttpResponse Api::get_field(const HttpRequest& r) { return respond(200, [&] { return fields_.get(r.param("id")); }); }
+
+HttpResponse Api::delete_field(const HttpRequest& r) { return respond_status(fields_.remove(r.param("id"))); }
+
+HttpResponse Api::get_field_file(const HttpRequest& r) { return respond_bytes(fields_.file_bytes(r.param("id"))); }
+
+HttpResponse Api::add_curve(const HttpRequest& r) {
+  auto result = [&]() -> Result<HttpResponse> {
+    SOLIDTEX_ASSIGN_OR_RETURN(QueryParams q, QueryParams::parse(r.query, {"timeout"}));
+    SOLIDTEX_RETURN_IF_ERROR(require_json_body(r));
+    SOLIDTEX_ASSIGN_OR_RETURN(auto interrupter, interrupter_for(r, q.get("timeout").value_or("")));
+    auto updated = fields_.add_curve(r.param("id"), r.body, *interrupter);
+    if (!updated && updated.status().code() == StatusCode::kCancelled) return interrupter->interruption_status("the field solve");
+    if (!updated) return updated.status();
+    return HttpResponse::json(200, *updated);
+  }();
+  return result ? *result : HttpResponse::error(result.status());
+}
+
+HttpResponse Api::sample_frames(const HttpRequest& r) {
+  return respond(200, [&]() -> Result<json> {
+    SOLIDTEX_ASSIGN_OR_RETURN(QueryParams q, QueryParams::parse(r.query, {"min", "size", "step"}));
+    SOLIDTEX_ASSIGN_OR_RETURN(auto min, q.get_list("min", 3));
+    SOLIDTEX_ASSIGN_OR_RETURN(auto size, q.get_int_list("size", 3));
+    SOLIDTEX_ASSIGN_OR_RETURN(double step, q.get_double("step", 1.0, 1e-6, 1e6));
+    return fields_.sample_frames(r.param("id"), {min[0], min[1], min[2]}, {size[0], size[1], size[2]}, step);
+  });
+}
+
+HttpResponse Api::list_volumes(const HttpRequest& r) {
+  if (Status s = no_query(r); !s.is_ok()) return HttpResponse::error(s);
+  return HttpResponse::json(200, volumes_.list());
+}
+
+HttpResponse Api::create_volume(const HttpRequest& r) {
+  auto result = [&]() -> Result<HttpResponse> {
+    SOLIDTEX_RETURN_IF_ERROR(no_query(r));
+    SOLIDTEX_RETURN_IF_ERROR(require_json_body(r));
+    SOLIDTEX_ASSIGN_OR_RETURN(json created, volumes_.create(r.body));
+    HttpResponse out = HttpResponse::json(201, created);
+    out.headers.push_back({"Location", "/v1/volumes/" + created["id"].get<std::string>()});
+    return out;
+  }();
+  return result ? *result : HttpResponse::error(result.status());
+}
+
+HttpResponse Api::get_volume(const HttpRequest& r) { return respond(200, [&] { return volumes_.get(r.param("id")); }); }
+
+HttpResponse Api::delete_volume(const HttpRequest& r) { return respond_status(volumes_.remove(r.param("id"))); }
+
+Result<HttpResponse> Api::synthesize_image(const HttpRequest& r, const std::string& kind, const TargetSet& target,
+                                           const std::string& timeout) {
+  SOLIDTEX_ASSIGN_OR_RETURN(auto interrupter, interrupter_for(r, timeout));
+  if (interrupter->was_interrupted()) return interrupter->interruption_status("the " + kind);
+  auto q = volumes_.query(r.param("id"), kind, target, *interrupter);
+  if (!q && q.status().code() == StatusCode::kCancelled) return interrupter->interruption_status("the " + kind);
+  if (!q) return q.status();
+  const std::string shape = std::to_string(target.height) + "," + std::to_string(target.width) + ",3";
+  SOLIDTEX_ASSIGN_OR_RETURN(HttpResponse out,
+                            encode_colours(q->rgb, target.width, target.height, shape, negotiate(r.accept, Encoding::kPng)));
+  out.headers.push_back({"X-Voxels-Synthesized", std::to_string(q->voxels_synthesized)});
+  return out;
+}
+
+HttpResponse Api::slice(const HttpRequest& r) {
+  auto result = [&]() -> Result<HttpResponse> {
+    SOLIDTEX_ASSIGN_OR_RETURN(QueryParams q, QueryParams::parse(r.query, {"axis", "at", "origin", "size", "timeout"}));
+    SOLIDTEX_ASSIGN_OR_RETURN(std::string axis, q.required("axis"));
+    if (axis != "x" && axis != "y" && axis != "z") return Status(StatusCode::kInvalidArgument, "must be x, y or z", "axis");
+    if (!q.has("at")) return Status(StatusCode::kInvalidArgument, "is required", "at");
+    SOLIDTEX_ASSIGN_OR_RETURN(int64_t at, q.get_int("at", 0, -(int64_t(1) << 28), int64_t(1) << 28));
+    std::vector<int> origin{0, 0};
+    if (q.has("origin")) {
+      SOLIDTEX_ASSIGN_OR_RETURN(origin, q.get_int_list("origin", 2));
+    }
+    SOLIDTEX_ASSIGN_OR_RETURN(auto size, q.get_int_list("size", 2));
+    if (size[0] < 1 || size[1] < 1) return Status(StatusCode::kInvalidArgument, "must be positive", "size");
+    SOLIDTEX_RETURN_IF_ERROR(volumes_.check_target_size(int64_t(size[0]) * size[1], "size"));
+    SOLIDTEX_ASSIGN_OR_RETURN(TargetSet target, TargetSet::axis_cut(axis[0], int(at), origin[0], origin[1], size[0], size[1]));
+    return synthesize_image(r, "slice", target, q.get("timeout").value_or(""));
+  }();
+  return result ? *result : HttpResponse::error(result.status());
+}
+
+HttpResponse Api::cut(const HttpRequest& r) {
+  auto result = [&]() -> Result<HttpResponse> {
+    SOLIDTEX_ASSIGN_OR_RETURN(QueryParams q, QueryParams::parse(r.query, {"timeout"}));
+    SOLIDTEX_RETURN_IF_ERROR(require_json_body(r));
+    SOLIDTEX_ASSIGN_OR_RETURN(json j, parse_json_text(r.body, "body"));
+    SOLIDTEX_RETURN_IF_ERROR(check_keys(j, {"origin", "u", "v", "size"}, ""));
+    for (const char* k : {"origin", "u", "v", "size"})
+      if (!j.contains(k)) return Status(StatusCode::kInvalidArgument, "is required", k);
+    SOLIDTEX_ASSIGN_OR_RETURN(WorldPoint origin, json_point(j["origin"], "origin"));
+    SOLIDTEX_ASSIGN_OR_RETURN(WorldPoint u, json_point(j["u"], "u"));
+    SOLIDTEX_ASSIGN_OR_RETURN(WorldPoint v, json_point(j["v"], "v"));
+    if (!j["size"].is_array() || j["size"].size() != 2)
+      return Status(StatusCode::kInvalidArgument, "must be [W, H]", "size");
+    SOLIDTEX_ASSIGN_OR_RETURN(int64_t w, json_int(j["size"][0], "size", 1, 1 << 20));
+    SOLIDTEX_ASSIGN_OR_RETURN(int64_t h, json_int(j["size"][1], "size", 1, 1 << 20));
+    SOLIDTEX_RETURN_IF_ERROR(volumes_.check_target_size(w * h, "size"));
+    SOLIDTEX_ASSIGN_OR_RETURN(TargetSet target, TargetSet::plane_cut(origin, u, v, int(w), int(h)));
+    return synthesize_image(r, "cut", target, q.get("timeout").value_or(""));
+  }();
+  return result ? *result : HttpResponse::error(result.status());
+}
+
+HttpResponse Api::region(const HttpRequest& r) {
+  auto result = [&]() -> Result<HttpResponse> {
+    SOLIDTEX_ASSIGN_OR_RETURN(QueryParams q, QueryParams::parse(r.query, {"min", "size", "timeout"}));
+    SOLIDTEX_ASSIGN_OR_RETURN(auto min, q.get_int_list("min", 3));
+    SOLIDTEX_ASSIGN_OR_RETURN(auto size, q.get_int_list("size", 3));
+    if (size[0] < 1 || size[1] < 1 || size[2] < 1) return Status(StatusCode::kInvalidArgument, "must be positive", "size");
+    SOLIDTEX_RETURN_IF_ERROR(volumes_.check_target_size(int64_t(size[0]) * size[1] * size[2], "size"));
+    SOLIDTEX_ASSIGN_OR_RETURN(TargetSet target, TargetSet::box(Voxel{min[0], min[1], min[2]}, size[0], size[1], size[2]));
+    SOLIDTEX_ASSIGN_OR_RETURN(auto interrupter, interrupter_for(r, q.get("timeout").value_or("")));
+    auto qr = volumes_.query(r.param("id"), "region", target, *interrupter);
+    if (!qr && qr.status().code() == StatusCode::kCancelled) return interrupter->interruption_status("the region");
+    if (!qr) return qr.status();
+    const Encoding enc = negotiate(r.accept, Encoding::kVdb);
+    HttpResponse out;
+    if (enc == Encoding::kVdb) {
+      SOLIDTEX_ASSIGN_OR_RETURN(out.body, encode_vdb_box(Voxel{min[0], min[1], min[2]}, {size[0], size[1], size[2]}, qr->rgb,
+                                                         r.param("id")));
+      out.content_type = "application/x-vdb";
+    } else {
+      const std::string shape = std::to_string(size[2]) + "," + std::to_string(size[1]) + "," + std::to_string(size[0]) + ",3";
+      SOLIDTEX_ASSIGN_OR_RETURN(out, encode_colours(qr->rgb, size[0], size[1] * size[2], shape, enc));
+    }
+    out.headers.push_back({"X-Voxels-Synthesized", std::to_string(qr->voxels_synthesized)});
+    return out;
+  }();
+  return result ? *result : HttpResponse::error(result.status());
+}
+
+HttpResponse Api::points(const HttpRequest& r) {
+  auto result = [&]() -> Result<HttpResponse> {
+    SOLIDTEX_ASSIGN_OR_RETURN(QueryParams q, QueryParams::parse(r.query, {"timeout"}));
+    std::vector<WorldPoint> pts;
+    if (r.content_type == "application/json") {
+      SOLIDTEX_ASSIGN_OR_RETURN(json j, parse_json_text(r.body, "body"));
+      SOLIDTEX_RETURN_IF_ERROR(check_keys(j, {"points"}, ""));
+      if (!j.contains("points") || !j["points"].is_array())
+        return Status(StatusCode::kInvalidArgument, "is required (an array of [x,y,z])", "points");
+      SOLIDTEX_RETURN_IF_ERROR(volumes_.check_target_size(int64_t(j["points"].size()), "points"));
+      for (size_t i = 0; i < j["points"].size(); ++i) {
+        SOLIDTEX_ASSIGN_OR_RETURN(WorldPoint p, json_point(j["points"][i], "points[" + std::to_string(i) + "]"));
+        pts.push_back(p);
+      }
+    } else if (r.content_type.empty() || r.content_type == "application/octet-stream") {
+      if (r.body.size() % 12 != 0)
+        return Status(StatusCode::kInvalidArgument,
+                      "must be little-endian float32 x,y,z triples (" + std::to_string(r.body.size()) + " bytes is not a multiple of 12)",
+                      "body");
+      SOLIDTEX_RETURN_IF_ERROR(volumes_.check_target_size(int64_t(r.body.size() / 12), "points"));
+      for (size_t i = 0; i < r.body.size() / 12; ++i) {
+        float v[3];
+        for (int c = 0; c < 3; ++c) {
+          uint32_t u = 0;
+          for (int b = 0; b < 4; ++b) u |= uint32_t(uint8_t(r.body[i * 12 + size_t(c) * 4 + size_t(b)])) << (8 * b);
+          v[c] = std::bit_cast<float>(u);
+          if (!std::isfinite(v[c]))
+            return Status(StatusCode::kInvalidArgument, "point " + std::to_string(i) + " is not finite", "body");
+        }
+        pts.push_back({v[0], v[1], v[2]});
+      }
+    } else {
+      return Status(StatusCode::kUnsupported, "expected application/octet-stream or application/json", "Content-Type");
+    }
+    if (pts.empty()) return Status(StatusCode::kInvalidArgument, "holds no points", "body");
+    SOLIDTEX_ASSIGN_OR_RETURN(TargetSet target, TargetSet::points(pts));
+    SOLIDTEX_ASSIGN_OR_RETURN(auto interrupter, interrupter_for(r, q.get("timeout").value_or("")));
+    auto qr = volumes_.query(r.param("id"), "points", target, *interrupter);
+    if (!qr && qr.status().code() == StatusCode::kCancelled) return interrupter->interruption_status("the points query");
+    if (!qr) return qr.status();
+    const Encoding enc = r.accept.find("application/json") != std::string::npos ? Encoding::kJson : Encoding::kFloat32;
+    SOLIDTEX_ASSIGN_OR_RETURN(HttpResponse out,
+                              encode_colours(qr->rgb, int(pts.size()), 1, std::to_string(pts.size()) + ",3", enc));
+    out.headers.push_back({"X-Voxels-Synthesized", std::to_string(qr->voxels_synthesized)});
+    return out;
+  }();
+  return result ? *result : HttpResponse::error(result.status());
+}
+
+HttpResponse Api::volume_stats(const HttpRequest& r) { return respond(200, [&] { return volumes_.stats(r.param("id")); }); }
+
+}  // namespace solidtex::server

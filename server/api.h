@@ -1,0 +1,67 @@
+// The handlers of the HTTP API (proto/openapi.json): each decodes an HttpRequest, calls a
+// service, and encodes the HttpResponse. No HTTP library here, no business logic either.
+// Heavy handlers (synthesis, analysis uploads, field solves) are run on the worker pool by the
+// adapter (routes.h says which); they derive an interrupter from the request's deadline
+// (query `timeout`, default --deadline) and disconnection, and answer 504 past the deadline.
+#pragma once
+
+#include <atomic>
+#include <memory>
+#include <string>
+
+#include "exemplar_service.h"
+#include "field_service.h"
+#include "http_types.h"
+#include "metrics.h"
+#include "server_config.h"
+#include "volume_service.h"
+#include "worker_pool.h"
+
+namespace solidtex::server {
+
+class Api {
+ public:
+  Api(const ServerConfig& config, ExemplarService& exemplars, FieldService& fields, VolumeService& volumes,
+      Metrics& metrics, const WorkerPool& pool, const std::atomic<bool>& shutting_down);
+
+  HttpResponse healthz(const HttpRequest& r);
+  HttpResponse metrics(const HttpRequest& r);
+  HttpResponse openapi(const HttpRequest& r);
+  HttpResponse list_exemplars(const HttpRequest& r);
+  HttpResponse upload_exemplar(const HttpRequest& r);
+  HttpResponse get_exemplar(const HttpRequest& r);
+  HttpResponse delete_exemplar(const HttpRequest& r);
+  HttpResponse get_exemplar_table(const HttpRequest& r);
+  HttpResponse get_job(const HttpRequest& r);
+  HttpResponse list_fields(const HttpRequest& r);
+  HttpResponse create_field(const HttpRequest& r);
+  HttpResponse get_field(const HttpRequest& r);
+  HttpResponse delete_field(const HttpRequest& r);
+  HttpResponse get_field_file(const HttpRequest& r);
+  HttpResponse add_curve(const HttpRequest& r);
+  HttpResponse sample_frames(const HttpRequest& r);
+  HttpResponse list_volumes(const HttpRequest& r);
+  HttpResponse create_volume(const HttpRequest& r);
+  HttpResponse get_volume(const HttpRequest& r);
+  HttpResponse delete_volume(const HttpRequest& r);
+  HttpResponse slice(const HttpRequest& r);
+  HttpResponse cut(const HttpRequest& r);
+  HttpResponse region(const HttpRequest& r);
+  HttpResponse points(const HttpRequest& r);
+  HttpResponse volume_stats(const HttpRequest& r);
+
+ private:
+  Result<std::unique_ptr<RequestInterrupter>> interrupter_for(const HttpRequest& r, const std::string& timeout) const;
+  Result<HttpResponse> synthesize_image(const HttpRequest& r, const std::string& kind, const TargetSet& target,
+                                        const std::string& timeout);
+
+  const ServerConfig& config_;
+  ExemplarService& exemplars_;
+  FieldService& fields_;
+  VolumeService& volumes_;
+  Metrics& metrics_;
+  const WorkerPool& pool_;
+  const std::atomic<bool>& shutting_down_;
+};
+
+}  // namespace solidtex::server

@@ -1,0 +1,23 @@
+// JSON encodings of the service's parameter structs, shared by the services and handlers.
+// Decoding is strict: unknown keys are errors naming their path; values are range-checked by
+// the structs' own validate().
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include "analysis.h"
+#include "analysis_params.h"
+#include "synthesis_params.h"
+
+namespace solidtex::server {
+
+nlohmann::json to_json(const AnalysisParams& p);
+Result<AnalysisParams> analysis_params_from_json(const nlohmann::json& j, const std::string& where);
+nlohmann::json to_json(const SynthesisParams& p);
+// `base` supplies what `j` leaves out (e.g. the table's suggested plane weights).
+Result<SynthesisParams> synthesis_params_from_json(const nlohmann::json& j, const std::string& where,
+                                                   SynthesisParams base);
+nlohmann::json to_json(const std::vector<LevelReport>& levels);
+nlohmann::json status_json(const Status& s);  // null when ok, else {"code","message","field"}
+
+}  // namespace solidtex::server

@@ -1,0 +1,360 @@
+#include "exemplar_service.h"
+
+#include <chrono>
+#include <condition_variable>
+#include <deque>
+#include <map>
+#include <mutex>
+#include <thread>
+
+#include "analysis.h"
+#include "api_json.h"
+#include "exemplar.h"
+#include "image_io.h"
+#include "json_fields.h"
+#include "table_file.h"
+
+namespace solidtex::server {
+
+using nlohmann::json;
+
+namespace {
+
+enum class State { kQueued, kRunning, kReady, kFailed };
+
+const char* kPartNames[] = {"xy", "yz", "zx", "mask", "mask_yz", "mask_zx"};
+
+std::string job_id_of(const std::string& exemplar_id) { return "job_" + exemplar_id.substr(3); }
+
+// Decoding errors of an uploaded image: the body arrived fine, its content is unusable.
+Status as_upload_error(const Status& s) {
+  if (s.code() == StatusCode::kTooLarge) return Status(StatusCode::kUnprocessable, s.message(), s.field());
+  return s;
+}
+
+struct Entry {
+  json meta;
+  State state = State::kQueued;
+  int percent = 0;
+  Status error;
+  json levels;
+  int64_t table_bytes = 0;
+  double seconds = 0;
+  std::shared_ptr<const Table> table;
+};
+
+}  // namespace
+
+struct ExemplarService::Impl {
+  DataStore& store;
+  ServerConfig config;
+  mutable std::mutex mutex;
+  std::condition_variable wake;
+  std::map<std::string, Entry> entries;
+  std::deque<std::string> pending;
+  std::vector<std::thread> threads;
+  std::atomic<bool> stopping{false};
+  int running = 0;
+
+  Impl(DataStore& s, const ServerConfig& c) : store(s), config(c) {}
+
+  Result<ExemplarSet> build_set(const std::vector<std::pair<std::string, std::vector<uint8_t>>>& parts,
+                                const std::string& grain, float mask_weight, AnalysisParams& params) const {
+    ExemplarInputs in;
+    bool have_xy = false;
+    for (const auto& [name, bytes] : parts) {
+      auto img = decode_image(bytes, config.image_limits, name);
+      if (!img) return as_upload_error(img.status());
+      if (name == "xy") { in.xy = std::move(*img); have_xy = true; }
+      else if (name == "yz") in.yz = std::move(*img);
+      else if (name == "zx") in.zx = std::move(*img);
+      else if (name == "mask") in.mask_xy = std::move(*img);
+      else if (name == "mask_yz") in.mask_yz = std::move(*img);
+      else if (name == "mask_zx") in.mask_zx = std::move(*img);
+      else return Status(StatusCode::kInvalidArgument, "unknown part (expected xy, yz, zx, mask, mask_yz, mask_zx)", name);
+    }
+    if (!have_xy) return Status(StatusCode::kInvalidArgument, "an exemplar image is required (part 'xy' or 'image')", "xy");
+    SOLIDTEX_RETURN_IF_ERROR(apply_grain_layout(grain, in, params.suggested_plane_weights));
+    in.mask_weight = mask_weight;
+    auto set = ExemplarSet::create(std::move(in));
+    if (!set) return Status(StatusCode::kUnprocessable, set.status().message(), set.status().field());
+    return set;
+  }
+
+  json exemplar_json(const std::string& id, const Entry& e) const {
+    json j = {{"id", id},
+              {"name", e.meta.value("name", "")},
+              {"state", e.state == State::kReady ? "ready" : e.state == State::kFailed ? "failed" : "analyzing"},
+              {"job_id", job_id_of(id)},
+              {"planes", e.meta.value("planes", 1)},
+              {"has_mask", e.meta.value("has_mask", false)},
+              {"width", e.meta.value("width", 0)},
+              {"height", e.meta.value("height", 0)},
+              {"grain", e.meta.value("grain", "")},
+              {"params", e.meta["params"]},
+              {"error", status_json(e.error)}};
+    if (e.state == State::kReady) {
+      j["levels"] = e.levels;
+      j["table_bytes"] = e.table_bytes;
+      j["seconds"] = e.seconds;
+    }
+    return j;
+  }
+
+  json job_json(const std::string& id, const Entry& e) const {
+    const char* state = e.state == State::kQueued    ? "queued"
+                        : e.state == State::kRunning ? "running"
+                        : e.state == State::kReady   ? "succeeded"
+                                                     : "failed";
+    return {{"id", job_id_of(id)}, {"kind", "analysis"},        {"exemplar_id", id},
+            {"state", state},      {"percent", e.percent},      {"seconds", e.seconds},
+            {"error", status_json(e.error)}};
+  }
+
+  // Reports progress into the entry; stops when the service shuts down.
+  class JobInterrupter : public Interrupter {
+   public:
+    JobInterrupter(Impl& impl, std::string id) : impl_(impl), id_(std::move(id)) {}
+    bool was_interrupted(int percent) override {
+      if (percent >= 0) {
+        std::lock_guard<std::mutex> g(impl_.mutex);
+        auto it = impl_.entries.find(id_);
+        if (it != impl_.entries.end()) it->second.percent = std::min(percent, 99);
+      }
+      return impl_.stopping.load();
+    }
+
+   private:
+    Impl& impl_;
+    std::string id_;
+  };
+
+  void run_analysis(const std::string& id) {
+    json meta;
+    {
+      std::lock_guard<std::mutex> g(mutex);
+      meta = entries.at(id).meta;
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    auto result = [&]() -> Result<json> {
+      std::vector<std::pair<std::string, std::vector<uint8_t>>> parts;
+      for (const auto& name : meta["parts"]) {
+        SOLIDTEX_ASSIGN_OR_RETURN(auto bytes, store.read(ResourceKind::kExemplar, id, name.get<std::string>() + ".img"));
+        parts.emplace_back(name.get<std::string>(), std::move(bytes));
+      }
+      SOLIDTEX_ASSIGN_OR_RETURN(AnalysisParams params, analysis_params_from_json(meta["params"], "params"));
+      AnalysisParams p = params;
+      SOLIDTEX_ASSIGN_OR_RETURN(ExemplarSet set, build_set(parts, meta.value("grain", ""), meta.value("mask_weight", 1.0f), p));
+      JobInterrupter interrupter(*this, id);
+      SOLIDTEX_ASSIGN_OR_RETURN(AnalysisResult r, analyze(set, params, interrupter));
+      const std::vector<uint8_t> bytes = encode_table(*r.table);
+      SOLIDTEX_RETURN_IF_ERROR(store.write(ResourceKind::kExemplar, id, "table.stx", bytes));
+      return json{{"levels", to_json(r.levels)}, {"table_bytes", int64_t(bytes.size())}, {"seconds", r.seconds}};
+    }();
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (!result && stopping.load()) return;  // abandoned: runs again at the next start
+    json record = result ? *result : json{{"error", status_json(result.status())}, {"seconds", seconds}};
+    // An exemplar deleted meanwhile has no directory any more; the write then fails harmlessly.
+    Status st = store.write_text(ResourceKind::kExemplar, id, "result.json", record.dump());
+    std::lock_guard<std::mutex> g(mutex);
+    auto it = entries.find(id);
+    if (it == entries.end()) return;
+    apply_result(it->second, st.is_ok() ? record : json{{"error", status_json(st)}});
+  }
+
+  void apply_result(Entry& e, const json& record) {
+    e.seconds = record.value("seconds", 0.0);
+    if (record.contains("error") && !record["error"].is_null()) {
+      e.state = State::kFailed;
+      const json& err = record["error"];
+      StatusCode code = StatusCode::kInternal;
+      for (int c = 1; c <= int(StatusCode::kIo); ++c)
+        if (err.value("code", "") == status_code_name(StatusCode(c))) code = StatusCode(c);
+      e.error = Status(code, err.value("message", ""), err.value("field", ""));
+    } else {
+      e.state = State::kReady;
+      e.percent = 100;
+      e.levels = record.value("levels", json::array());
+      e.table_bytes = record.value("table_bytes", int64_t(0));
+    }
+  }
+
+  void worker() {
+    for (;;) {
+      std::string id;
+      {
+        std::unique_lock<std::mutex> lock(mutex);
+        wake.wait(lock, [&] { return stopping.load() || !pending.empty(); });
+        if (stopping.load()) return;
+        id = pending.front();
+        pending.pop_front();
+        auto it = entries.find(id);
+        if (it == entries.end()) continue;
+        it->second.state = State::kRunning;
+        ++running;
+      }
+      run_analysis(id);
+      std::lock_guard<std::mutex> g(mutex);
+      --running;
+    }
+  }
+};
+
+ExemplarService::ExemplarService(DataStore& store, const ServerConfig& config)
+    : impl_(std::make_unique<Impl>(store, config)) {}
+
+ExemplarService::~ExemplarService() { shutdown(); }
+
+Status ExemplarService::start(std::vector<std::string>* report) {
+  for (const std::string& id : impl_->store.ids(ResourceKind::kExemplar)) {
+    auto text = impl_->store.read_text(ResourceKind::kExemplar, id, "meta.json");
+    auto meta = text ? parse_json_text(*text, "meta.json") : Result<json>(text.status());
+    if (!meta) {
+      if (report) report->push_back("skipped exemplar " + id + ": " + meta.status().to_string());
+      continue;
+    }
+    Entry e;
+    e.meta = *meta;
+    if (impl_->store.exists(ResourceKind::kExemplar, id, "result.json")) {
+      auto r = impl_->store.read_text(ResourceKind::kExemplar, id, "result.json");
+      auto record = r ? parse_json_text(*r, "result.json") : Result<json>(r.status());
+      if (record) {
+        impl_->apply_result(e, *record);
+      } else {
+        e.state = State::kFailed;
+        e.error = record.status();
+      }
+    } else {
+      impl_->pending.push_back(id);
+      if (report) report->push_back("re-queued the analysis of exemplar " + id);
+    }
+    impl_->entries.emplace(id, std::move(e));
+  }
+  for (int i = 0; i < impl_->config.analysis_threads; ++i) impl_->threads.emplace_back([this] { impl_->worker(); });
+  return Status::ok();
+}
+
+void ExemplarService::shutdown() {
+  {
+    std::lock_guard<std::mutex> g(impl_->mutex);
+    impl_->stopping = true;
+  }
+  impl_->wake.notify_all();
+  for (auto& t : impl_->threads) t.join();
+  impl_->threads.clear();
+}
+
+int ExemplarService::jobs_pending() const {
+  std::lock_guard<std::mutex> g(impl_->mutex);
+  return int(impl_->pending.size()) + impl_->running;
+}
+
+Result<json> ExemplarService::upload(ExemplarUpload up) {
+  for (auto& [name, bytes] : up.parts)
+    if (name == "image") name = "xy";
+  if (!(up.mask_weight >= 0 && up.mask_weight <= 10))
+    return Status(StatusCode::kInvalidArgument, "must be in [0, 10]", "mask_weight");
+  if (jobs_pending() >= impl_->config.max_jobs)
+    return Status(StatusCode::kRateLimited,
+                  std::to_string(impl_->config.max_jobs) + " analyses are already queued or running; retry later");
+  AnalysisParams params = up.params;
+  params.search_k = std::max(params.search_k, params.candidates / 2 + 1);
+  SOLIDTEX_RETURN_IF_ERROR(params.validate());
+  SOLIDTEX_ASSIGN_OR_RETURN(ExemplarSet set, impl_->build_set(up.parts, up.grain, up.mask_weight, params));
+
+  const std::string id = DataStore::new_id("ex_");
+  json parts = json::array();
+  SOLIDTEX_RETURN_IF_ERROR(impl_->store.create(ResourceKind::kExemplar, id));
+  for (const auto& [name, bytes] : up.parts) {
+    SOLIDTEX_RETURN_IF_ERROR(impl_->store.write(ResourceKind::kExemplar, id, name + ".img", bytes));
+    parts.push_back(name);
+  }
+  const ImageF& xy = set.plane(Plane::kXY);
+  Entry e;
+  e.meta = {{"id", id},
+            {"name", up.name},
+            {"params", to_json(params)},
+            {"grain", up.grain},
+            {"mask_weight", up.mask_weight},
+            {"parts", parts},
+            {"planes", set.shared() ? 1 : 3},
+            {"has_mask", set.has_mask()},
+            {"width", xy.width},
+            {"height", xy.height}};
+  Status st = impl_->store.write_text(ResourceKind::kExemplar, id, "meta.json", e.meta.dump());
+  if (!st.is_ok()) {
+    impl_->store.remove(ResourceKind::kExemplar, id);
+    return st;
+  }
+  std::lock_guard<std::mutex> g(impl_->mutex);
+  const Entry& stored = impl_->entries.emplace(id, std::move(e)).first->second;
+  impl_->pending.push_back(id);
+  impl_->wake.notify_one();
+  return json{{"exemplar", impl_->exemplar_json(id, stored)}, {"job", impl_->job_json(id, stored)}};
+}
+
+Result<json> ExemplarService::get(const std::string& id) const {
+  std::lock_guard<std::mutex> g(impl_->mutex);
+  auto it = impl_->entries.find(id);
+  if (it == impl_->entries.end()) return Status(StatusCode::kNotFound, "no exemplar '" + id + "'", "id");
+  return impl_->exemplar_json(id, it->second);
+}
+
+json ExemplarService::list() const {
+  std::lock_guard<std::mutex> g(impl_->mutex);
+  json out = json::array();
+  for (const auto& [id, e] : impl_->entries) out.push_back(impl_->exemplar_json(id, e));
+  return {{"exemplars", out}};
+}
+
+Result<json> ExemplarService::job(const std::string& job_id) const {
+  std::lock_guard<std::mutex> g(impl_->mutex);
+  if (job_id.rfind("job_", 0) == 0) {
+    auto it = impl_->entries.find("ex_" + job_id.substr(4));
+    if (it != impl_->entries.end()) return impl_->job_json(it->first, it->second);
+  }
+  return Status(StatusCode::kNotFound, "no job '" + job_id + "'", "id");
+}
+
+Status ExemplarService::remove(const std::string& id, const std::function<bool(const std::string&)>& in_use) {
+  std::lock_guard<std::mutex> g(impl_->mutex);
+  auto it = impl_->entries.find(id);
+  if (it == impl_->entries.end()) return Status(StatusCode::kNotFound, "no exemplar '" + id + "'", "id");
+  if (it->second.state == State::kQueued || it->second.state == State::kRunning)
+    return Status(StatusCode::kFailedPrecondition, "exemplar '" + id + "' is still being analysed", "id");
+  if (in_use(id)) return Status(StatusCode::kFailedPrecondition, "exemplar '" + id + "' is used by a volume", "id");
+  SOLIDTEX_RETURN_IF_ERROR(impl_->store.remove(ResourceKind::kExemplar, id));
+  impl_->entries.erase(it);
+  return Status::ok();
+}
+
+Result<std::shared_ptr<const Table>> ExemplarService::table(const std::string& id) {
+  {
+    std::lock_guard<std::mutex> g(impl_->mutex);
+    auto it = impl_->entries.find(id);
+    if (it == impl_->entries.end()) return Status(StatusCode::kNotFound, "no exemplar '" + id + "'", "exemplar");
+    if (it->second.state != State::kReady)
+      return Status(StatusCode::kFailedPrecondition, "exemplar '" + id + "' is not ready", "exemplar");
+    if (it->second.table) return it->second.table;
+  }
+  // Decoding (Table::assemble rebuilds stacks) runs outside the lock.
+  SOLIDTEX_ASSIGN_OR_RETURN(auto bytes, table_bytes(id));
+  SOLIDTEX_ASSIGN_OR_RETURN(auto table, decode_table(bytes));
+  std::lock_guard<std::mutex> g(impl_->mutex);
+  auto it = impl_->entries.find(id);
+  if (it != impl_->entries.end() && !it->second.table) it->second.table = table;
+  return it != impl_->entries.end() ? it->second.table : table;
+}
+
+Result<std::vector<uint8_t>> ExemplarService::table_bytes(const std::string& id) const {
+  {
+    std::lock_guard<std::mutex> g(impl_->mutex);
+    auto it = impl_->entries.find(id);
+    if (it == impl_->entries.end()) return Status(StatusCode::kNotFound, "no exemplar '" + id + "'", "id");
+    if (it->second.state != State::kReady)
+      return Status(StatusCode::kFailedPrecondition, "exemplar '" + id + "' is not ready", "id");
+  }
+  return impl_->store.read(ResourceKind::kExemplar, id, "table.stx");
+}
+
+}  // namespace solidtex::server

@@ -1,0 +1,63 @@
+// Exemplars: uploads, their background analysis into candidate-triple tables, and the tables.
+//
+// upload() decodes every image (dimensions checked from the header first) and builds the
+// ExemplarSet synchronously, so bad input is refused before anything is stored; then it stores
+// the uploaded bytes and meta.json (the acknowledgement: see data_store.h) and queues the
+// analysis. Analyses run on `analysis_threads` threads of their own, at most `max_jobs`
+// queued or running (beyond: kRateLimited). A job's id derives from its exemplar's, so a job
+// survives restarts: start() re-queues every acknowledged exemplar without a result, and an
+// analysis interrupted by shutdown writes nothing and runs again at the next start.
+// Analysis is deterministic, so the stored table equals `solidtex analyze` on the same inputs.
+// Thread-safe.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "analysis_params.h"
+#include "data_store.h"
+#include "server_config.h"
+#include "table.h"
+
+namespace solidtex::server {
+
+struct ExemplarUpload {
+  std::string name;
+  AnalysisParams params;
+  std::string grain;         // "" or "x" (exemplar.h: apply_grain_layout)
+  float mask_weight = 1.0f;  // [0, 10]
+  // Named parts: "xy" (required), "yz" and "zx" (both or neither), "mask", "mask_yz", "mask_zx".
+  std::vector<std::pair<std::string, std::vector<uint8_t>>> parts;
+};
+
+class ExemplarService {
+ public:
+  ExemplarService(DataStore& store, const ServerConfig& config);
+  ~ExemplarService();  // shutdown()
+
+  Status start(std::vector<std::string>* report);
+  // Stops the analysis threads; a running analysis is abandoned (re-run at next start).
+  void shutdown();
+
+  Result<nlohmann::json> upload(ExemplarUpload upload);  // {"exemplar": ..., "job": ...}
+  Result<nlohmann::json> get(const std::string& id) const;
+  nlohmann::json list() const;
+  Result<nlohmann::json> job(const std::string& job_id) const;
+  // kFailedPrecondition while analysing or when `in_use(id)` says a volume needs it.
+  Status remove(const std::string& id, const std::function<bool(const std::string&)>& in_use);
+  // The decoded table of a ready exemplar (kFailedPrecondition otherwise); cached in memory.
+  Result<std::shared_ptr<const Table>> table(const std::string& id);
+  Result<std::vector<uint8_t>> table_bytes(const std::string& id) const;
+  int jobs_pending() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace solidtex::server

@@ -1,0 +1,282 @@
+#include "field_service.h"
+
+#include <chrono>
+#include <map>
+#include <mutex>
+
+#include "api_json.h"
+#include "json_fields.h"
+#include "sketch.h"
+#include "tensor_field.h"
+
+namespace solidtex::server {
+
+using nlohmann::json;
+
+namespace {
+
+constexpr size_t kMaxLiveSolvers = 8;
+constexpr int64_t kMaxFramesPerRequest = 65536;
+
+std::string stf_name(int revision) { return "r" + std::to_string(revision) + ".stf"; }
+std::string json_name(int revision) { return "r" + std::to_string(revision) + ".json"; }
+
+struct FieldEntry {
+  int revision = 0;
+  json info;                                  // r<N>.json: what GET answers
+  std::shared_ptr<const QuatGridField> field;  // the current revision, decoded
+  std::unique_ptr<FieldSolver> solver;        // live solver (may be null: rebuilt on demand)
+  uint64_t last_use = 0;
+  std::shared_ptr<std::mutex> busy = std::make_shared<std::mutex>();  // serialises add_curve
+};
+
+
+}  // namespace
+
+struct FieldService::Impl {
+  DataStore& store;
+  ServerConfig config;
+  mutable std::mutex mutex;
+  std::map<std::string, FieldEntry> entries;
+  uint64_t tick = 0;
+
+  Impl(DataStore& s, const ServerConfig& c) : store(s), config(c) {}
+
+  // Solves the curves of `sketch` one by one, checking the interrupter in between.
+  Result<std::unique_ptr<FieldSolver>> solve(const Sketch& sketch, Interrupter& interrupter, FieldSolveStats& stats) {
+    SOLIDTEX_ASSIGN_OR_RETURN(auto solver, FieldSolver::create(sketch.domain));
+    const auto d = solver->dims();
+    const int64_t nodes = int64_t(d[0]) * d[1] * d[2];
+    if (nodes > config.max_field_nodes)
+      return Status(StatusCode::kUnprocessable,
+                    "the field grid would have " + std::to_string(nodes) + " nodes; the limit is " +
+                        std::to_string(config.max_field_nodes) + " (lower shortest_side_cells or the domain's aspect)",
+                    "domain.shortest_side_cells");
+    const auto t0 = std::chrono::steady_clock::now();
+    for (size_t i = 0; i < sketch.curves.size(); ++i) {
+      if (interrupter.was_interrupted(int(100 * i / sketch.curves.size())))
+        return Status(StatusCode::kCancelled, "field solve interrupted");
+      SOLIDTEX_RETURN_IF_ERROR(solver->add_curve(sketch.curves[i], int(i), &stats));
+    }
+    SOLIDTEX_RETURN_IF_ERROR(solver->set_scales(sketch.scales));
+    stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return solver;
+  }
+
+  // Writes revision `revision` (the .stf, then its .json) and returns the info.
+  Result<json> store_revision(const std::string& id, int revision, const FieldSolver& solver,
+                              const FieldSolveStats& stats, const std::string& sketch_text, FieldEntry& e) {
+    StoredField f;
+    f.origin = solver.origin();
+    f.spacing = solver.spacing();
+    f.dims = solver.dims();
+    f.singular_nodes = stats.singular_nodes;
+    f.nodes = solver.nodes();
+    f.log_scales = solver.log_scales();
+    f.sketch_json = sketch_text;
+    SOLIDTEX_RETURN_IF_ERROR(store.write(ResourceKind::kField, id, stf_name(revision), encode_field(f)));
+    json info = {{"id", id},
+                 {"revision", revision},
+                 {"curves", solver.curve_count()},
+                 {"dims", f.dims},
+                 {"origin", {f.origin.x, f.origin.y, f.origin.z}},
+                 {"spacing", f.spacing},
+                 {"singular_nodes", f.singular_nodes},
+                 {"residual", stats.residual},
+                 {"seconds", stats.seconds},
+                 {"has_scales", !f.log_scales.empty()}};
+    SOLIDTEX_RETURN_IF_ERROR(store.write_text(ResourceKind::kField, id, json_name(revision), info.dump()));
+    SOLIDTEX_ASSIGN_OR_RETURN(e.field, QuatGridField::create(f.origin, f.spacing, f.dims, f.nodes, f.log_scales));
+    e.revision = revision;
+    e.info = info;
+    return info;
+  }
+
+  // Keeps at most kMaxLiveSolvers solvers in memory (least recently used dropped).
+  void trim_solvers() {
+    size_t live = 0;
+    for (auto& [id, e] : entries) live += e.solver ? 1 : 0;
+    while (live > kMaxLiveSolvers) {
+      FieldEntry* oldest = nullptr;
+      for (auto& [id, e] : entries)
+        if (e.solver && (!oldest || e.last_use < oldest->last_use)) oldest = &e;
+      oldest->solver.reset();
+      --live;
+    }
+  }
+
+  Result<StoredField> load_revision(const std::string& id, int revision) const {
+    SOLIDTEX_ASSIGN_OR_RETURN(auto bytes, store.read(ResourceKind::kField, id, stf_name(revision)));
+    return decode_field(bytes);
+  }
+};
+
+FieldService::FieldService(DataStore& store, const ServerConfig& config) : impl_(std::make_unique<Impl>(store, config)) {}
+FieldService::~FieldService() = default;
+
+Status FieldService::start(std::vector<std::string>* report) {
+  for (const std::string& id : impl_->store.ids(ResourceKind::kField)) {
+    // The newest revision with both files; a crash between its .stf and .json leaves the
+    // previous revision current.
+    int revision = 0;
+    for (const std::string& f : impl_->store.files(ResourceKind::kField, id)) {
+      if (f.size() > 6 && f[0] == 'r' && f.ends_with(".json")) {
+        const int r = std::atoi(f.substr(1, f.size() - 6).c_str());
+        if (r > revision && impl_->store.exists(ResourceKind::kField, id, stf_name(r))) revision = r;
+      }
+    }
+    FieldEntry e;
+    auto text = impl_->store.read_text(ResourceKind::kField, id, json_name(revision));
+    auto info = text ? parse_json_text(*text, "field info") : Result<json>(text.status());
+    auto stored = info ? impl_->load_revision(id, revision) : Result<StoredField>(info.status());
+    if (stored) {
+      auto field = QuatGridField::create(stored->origin, stored->spacing, stored->dims, stored->nodes, stored->log_scales);
+      if (field) {
+        e.field = *field;
+        e.info = *info;
+        e.revision = revision;
+        impl_->entries.emplace(id, std::move(e));
+        continue;
+      }
+      stored = Result<StoredField>(field.status());
+    }
+    if (report) report->push_back("skipped field " + id + ": " + stored.status().to_string());
+  }
+  return Status::ok();
+}
+
+Result<json> FieldService::create(const std::string& sketch_text, Interrupter& interrupter) {
+  SOLIDTEX_ASSIGN_OR_RETURN(Sketch sketch, parse_sketch_json(sketch_text));
+  FieldSolveStats stats;
+  SOLIDTEX_ASSIGN_OR_RETURN(auto solver, impl_->solve(sketch, interrupter, stats));
+  const std::string id = DataStore::new_id("fld_");
+  SOLIDTEX_RETURN_IF_ERROR(impl_->store.create(ResourceKind::kField, id));
+  FieldEntry e;
+  auto info = impl_->store_revision(id, 1, *solver, stats, sketch_text, e);
+  if (!info) {
+    impl_->store.remove(ResourceKind::kField, id);
+    return info.status();
+  }
+  std::lock_guard<std::mutex> g(impl_->mutex);
+  e.solver = std::move(solver);
+  e.last_use = ++impl_->tick;
+  impl_->entries.emplace(id, std::move(e));
+  impl_->trim_solvers();
+  return *info;
+}
+
+Result<json> FieldService::add_curve(const std::string& id, const std::string& curve_text, Interrupter& interrupter) {
+  std::shared_ptr<std::mutex> busy;
+  {
+    std::lock_guard<std::mutex> g(impl_->mutex);
+    auto it = impl_->entries.find(id);
+    if (it == impl_->entries.end()) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
+    busy = it->second.busy;
+  }
+  std::lock_guard<std::mutex> one_at_a_time(*busy);
+  int revision = 0;
+  std::unique_ptr<FieldSolver> solver;
+  {
+    std::lock_guard<std::mutex> g(impl_->mutex);
+    auto it = impl_->entries.find(id);
+    if (it == impl_->entries.end()) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
+    revision = it->second.revision;
+    solver = std::move(it->second.solver);
+  }
+  SOLIDTEX_ASSIGN_OR_RETURN(StoredField current, impl_->load_revision(id, revision));
+  SOLIDTEX_ASSIGN_OR_RETURN(Sketch sketch, parse_sketch_json(current.sketch_json));
+  const int index = int(sketch.curves.size());
+  SOLIDTEX_ASSIGN_OR_RETURN(SketchCurve curve, parse_curve_json(curve_text, index));
+  SOLIDTEX_RETURN_IF_ERROR(validate_curve(curve, sketch.domain, index));
+  FieldSolveStats stats;
+  if (!solver) {
+    SOLIDTEX_ASSIGN_OR_RETURN(solver, impl_->solve(sketch, interrupter, stats));
+  }
+  if (interrupter.was_interrupted()) return Status(StatusCode::kCancelled, "field solve interrupted");
+  const auto t0 = std::chrono::steady_clock::now();
+  SOLIDTEX_RETURN_IF_ERROR(solver->add_curve(curve, index, &stats));
+  stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  // The stored sketch grows by the curve, so the revision's file is a complete sketch.
+  json sketch_json = json::parse(current.sketch_json);
+  sketch_json["curves"].push_back(json::parse(curve_text));
+  FieldEntry updated;
+  SOLIDTEX_ASSIGN_OR_RETURN(json info, impl_->store_revision(id, revision + 1, *solver, stats, sketch_json.dump(), updated));
+  std::lock_guard<std::mutex> g(impl_->mutex);
+  auto it = impl_->entries.find(id);
+  if (it == impl_->entries.end()) return Status(StatusCode::kNotFound, "field '" + id + "' was deleted", "id");
+  it->second.revision = updated.revision;
+  it->second.info = updated.info;
+  it->second.field = updated.field;
+  it->second.solver = std::move(solver);
+  it->second.last_use = ++impl_->tick;
+  impl_->trim_solvers();
+  return info;
+}
+
+Result<json> FieldService::get(const std::string& id) const {
+  std::lock_guard<std::mutex> g(impl_->mutex);
+  auto it = impl_->entries.find(id);
+  if (it == impl_->entries.end()) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
+  return it->second.info;
+}
+
+json FieldService::list() const {
+  std::lock_guard<std::mutex> g(impl_->mutex);
+  json out = json::array();
+  for (const auto& [id, e] : impl_->entries) out.push_back(e.info);
+  return {{"fields", out}};
+}
+
+Status FieldService::remove(const std::string& id) {
+  std::lock_guard<std::mutex> g(impl_->mutex);
+  auto it = impl_->entries.find(id);
+  if (it == impl_->entries.end()) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
+  SOLIDTEX_RETURN_IF_ERROR(impl_->store.remove(ResourceKind::kField, id));
+  impl_->entries.erase(it);
+  return Status::ok();
+}
+
+Result<std::vector<uint8_t>> FieldService::file_bytes(const std::string& id, int* revision) const {
+  int r = 0;
+  {
+    std::lock_guard<std::mutex> g(impl_->mutex);
+    auto it = impl_->entries.find(id);
+    if (it == impl_->entries.end()) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
+    r = it->second.revision;
+  }
+  if (revision) *revision = r;
+  return impl_->store.read(ResourceKind::kField, id, stf_name(r));
+}
+
+Result<json> FieldService::sample_frames(const std::string& id, const WorldPoint& min, std::array<int, 3> size,
+                                         double step) const {
+  std::shared_ptr<const QuatGridField> field;
+  {
+    std::lock_guard<std::mutex> g(impl_->mutex);
+    auto it = impl_->entries.find(id);
+    if (it == impl_->entries.end()) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
+    field = it->second.field;
+  }
+  int64_t count = 1;
+  for (int s : size) {
+    if (s < 1) return Status(StatusCode::kInvalidArgument, "every count must be >= 1", "size");
+    count *= s;
+    if (count > kMaxFramesPerRequest)
+      return Status(StatusCode::kUnprocessable, "at most " + std::to_string(kMaxFramesPerRequest) + " points per request", "size");
+  }
+  if (!(step > 0 && step <= 1e6)) return Status(StatusCode::kInvalidArgument, "must be in (0, 1e6]", "step");
+  json points = json::array(), quats = json::array(), scales = json::array();
+  for (int k = 0; k < size[2]; ++k)
+    for (int j = 0; j < size[1]; ++j)
+      for (int i = 0; i < size[0]; ++i) {
+        const WorldPoint p{min.x + step * i, min.y + step * j, min.z + step * k};
+        const Quat q = field->at(p);
+        const auto s = field->scale_at(p);
+        points.push_back({p.x, p.y, p.z});
+        quats.push_back({q.w, q.x, q.y, q.z});
+        scales.push_back({s[0], s[1], s[2]});
+      }
+  return json{{"points", points}, {"quaternions", quats}, {"scales", scales}};
+}
+
+}  // namespace solidtex::server

@@ -1,0 +1,44 @@
+// Frame fields solved from sketches (Zhang §3), stored as revisions: creation is revision 1,
+// every added curve makes the next revision (data_store.h: fields/<id>/r<N>.stf + r<N>.json).
+// A revision never changes once written, and volumes copy the revision they use, so adding a
+// curve never alters an existing volume. The solver of a recently used field stays in memory
+// so that adding a curve re-solves incrementally (warm start); after a restart the first added
+// curve re-solves the stored sketch first. Solves check the interrupter between curves.
+// Thread-safe; operations on one field are serialised.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include <memory>
+#include <string>
+
+#include "data_store.h"
+#include "field_file.h"
+#include "interrupter.h"
+#include "server_config.h"
+
+namespace solidtex::server {
+
+class FieldService {
+ public:
+  FieldService(DataStore& store, const ServerConfig& config);
+  ~FieldService();
+
+  Status start(std::vector<std::string>* report);
+  Result<nlohmann::json> create(const std::string& sketch_json, Interrupter& interrupter);
+  Result<nlohmann::json> add_curve(const std::string& id, const std::string& curve_json, Interrupter& interrupter);
+  Result<nlohmann::json> get(const std::string& id) const;
+  nlohmann::json list() const;
+  Status remove(const std::string& id);
+  // The current revision's .stf bytes, and its number.
+  Result<std::vector<uint8_t>> file_bytes(const std::string& id, int* revision = nullptr) const;
+  // Frames (and scales) at min + step * (i, j, k) for i < size[0], j < size[1], k < size[2].
+  Result<nlohmann::json> sample_frames(const std::string& id, const WorldPoint& min, std::array<int, 3> size,
+                                       double step) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace solidtex::server

@@ -1,0 +1,39 @@
+#include "http_errors.h"
+
+#include <nlohmann/json.hpp>
+
+namespace solidtex::server {
+
+int http_status_for(StatusCode code) {
+  switch (code) {
+    case StatusCode::kOk: return 200;
+    case StatusCode::kInvalidArgument: return 400;
+    case StatusCode::kNotFound: return 404;
+    case StatusCode::kUnsupported: return 415;
+    case StatusCode::kTooLarge: return 413;
+    case StatusCode::kCorrupt:
+    case StatusCode::kVersionMismatch:
+    case StatusCode::kUnprocessable: return 422;
+    case StatusCode::kAlreadyExists:
+    case StatusCode::kFailedPrecondition: return 409;
+    case StatusCode::kRateLimited: return 429;
+    // Cancelled: the client went away or the server is shutting down; either way "not now".
+    case StatusCode::kCancelled:
+    case StatusCode::kResourceExhausted: return 503;
+    case StatusCode::kDeadlineExceeded: return 504;
+    case StatusCode::kInternal:
+    case StatusCode::kIo: return 500;
+  }
+  return 500;
+}
+
+std::string error_body(const std::string& code, const std::string& message, const std::string& field) {
+  nlohmann::json j = {{"error", {{"code", code}, {"message", message}, {"field", field}}}};
+  return j.dump();
+}
+
+std::string error_body(const Status& status) {
+  return error_body(status_code_name(status.code()), status.message(), status.field());
+}
+
+}  // namespace solidtex::server

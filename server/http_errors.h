@@ -1,0 +1,17 @@
+// The one place that maps solidtex StatusCodes to HTTP statuses, and the one JSON error shape
+// every endpoint answers with: {"error": {"code", "message", "field"}}.
+#pragma once
+
+#include <string>
+
+#include "status.h"
+
+namespace solidtex::server {
+
+int http_status_for(StatusCode code);
+// {"error": {"code": "<status_code_name>", "message": ..., "field": ...}}
+std::string error_body(const Status& status);
+// For errors the HTTP layer itself raises (no route, wrong method): explicit code name.
+std::string error_body(const std::string& code, const std::string& message, const std::string& field);
+
+}  // namespace solidtex::server

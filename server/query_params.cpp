@@ -1,0 +1,81 @@
+#include "query_params.h"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+
+#include "number_list.h"
+
+namespace solidtex::server {
+
+Result<QueryParams> QueryParams::parse(const std::vector<std::pair<std::string, std::string>>& query,
+                                       const std::set<std::string>& allowed) {
+  QueryParams q;
+  std::set<std::string> seen;
+  for (const auto& [k, v] : query) {
+    if (!allowed.count(k)) {
+      std::string list;
+      for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+      return Status(StatusCode::kInvalidArgument,
+                    "unknown query parameter" + (list.empty() ? std::string(" (none accepted)") : " (accepted: " + list + ")"), k);
+    }
+    if (!seen.insert(k).second) return Status(StatusCode::kInvalidArgument, "given more than once", k);
+    q.values_.emplace_back(k, v);
+  }
+  return q;
+}
+
+bool QueryParams::has(const std::string& key) const { return get(key).has_value(); }
+
+std::optional<std::string> QueryParams::get(const std::string& key) const {
+  for (const auto& [k, v] : values_)
+    if (k == key) return v;
+  return std::nullopt;
+}
+
+Result<std::string> QueryParams::required(const std::string& key) const {
+  auto v = get(key);
+  if (!v) return Status(StatusCode::kInvalidArgument, "is required", key);
+  return *v;
+}
+
+Result<int64_t> QueryParams::get_int(const std::string& key, int64_t fallback, int64_t lo, int64_t hi) const {
+  auto v = get(key);
+  if (!v) return fallback;
+  errno = 0;
+  char* end = nullptr;
+  const long long n = std::strtoll(v->c_str(), &end, 10);
+  if (v->empty() || *end != '\0' || errno == ERANGE) return Status(StatusCode::kInvalidArgument, "must be an integer", key);
+  if (n < lo || n > hi)
+    return Status(StatusCode::kInvalidArgument, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]", key);
+  return int64_t(n);
+}
+
+Result<double> QueryParams::get_double(const std::string& key, double fallback, double lo, double hi) const {
+  auto v = get(key);
+  if (!v) return fallback;
+  char* end = nullptr;
+  const double d = std::strtod(v->c_str(), &end);
+  if (v->empty() || *end != '\0' || !std::isfinite(d)) return Status(StatusCode::kInvalidArgument, "must be a number", key);
+  if (d < lo || d > hi)
+    return Status(StatusCode::kInvalidArgument, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]", key);
+  return d;
+}
+
+Result<std::vector<double>> QueryParams::get_list(const std::string& key, size_t count) const {
+  SOLIDTEX_ASSIGN_OR_RETURN(std::string v, required(key));
+  return parse_number_list(v, count, key);
+}
+
+Result<std::vector<int>> QueryParams::get_int_list(const std::string& key, size_t count) const {
+  SOLIDTEX_ASSIGN_OR_RETURN(auto v, get_list(key, count));
+  std::vector<int> out;
+  for (double d : v) {
+    if (d != std::floor(d) || std::abs(d) > double(1 << 28))
+      return Status(StatusCode::kInvalidArgument, "must be integers within +-2^28", key);
+    out.push_back(int(d));
+  }
+  return out;
+}
+
+}  // namespace solidtex::server

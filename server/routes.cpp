@@ -1,0 +1,90 @@
+#include "routes.h"
+
+namespace solidtex::server {
+
+const std::vector<Route>& route_table() {
+  using E = Execution;
+  static const std::vector<Route> routes{
+      {"GET", "/healthz", E::kInline, &Api::healthz},
+      {"GET", "/metrics", E::kInline, &Api::metrics},
+      {"GET", "/v1/openapi.json", E::kInline, &Api::openapi},
+      {"GET", "/v1/exemplars", E::kInline, &Api::list_exemplars},
+      {"POST", "/v1/exemplars", E::kWorker, &Api::upload_exemplar},
+      {"GET", "/v1/exemplars/{id}", E::kInline, &Api::get_exemplar},
+      {"DELETE", "/v1/exemplars/{id}", E::kWorker, &Api::delete_exemplar},
+      {"GET", "/v1/exemplars/{id}/table", E::kWorker, &Api::get_exemplar_table},
+      {"GET", "/v1/jobs/{id}", E::kInline, &Api::get_job},
+      {"GET", "/v1/fields", E::kInline, &Api::list_fields},
+      {"POST", "/v1/fields", E::kWorker, &Api::create_field},
+      {"GET", "/v1/fields/{id}", E::kInline, &Api::get_field},
+      {"DELETE", "/v1/fields/{id}", E::kWorker, &Api::delete_field},
+      {"GET", "/v1/fields/{id}/file", E::kWorker, &Api::get_field_file},
+      {"POST", "/v1/fields/{id}/curves", E::kWorker, &Api::add_curve},
+      {"GET", "/v1/fields/{id}/frames", E::kWorker, &Api::sample_frames},
+      {"GET", "/v1/volumes", E::kInline, &Api::list_volumes},
+      {"POST", "/v1/volumes", E::kWorker, &Api::create_volume},
+      {"GET", "/v1/volumes/{id}", E::kInline, &Api::get_volume},
+      {"DELETE", "/v1/volumes/{id}", E::kWorker, &Api::delete_volume},
+      {"GET", "/v1/volumes/{id}/slice", E::kWorker, &Api::slice},
+      {"POST", "/v1/volumes/{id}/cut", E::kWorker, &Api::cut},
+      {"GET", "/v1/volumes/{id}/region", E::kWorker, &Api::region},
+      {"POST", "/v1/volumes/{id}/points", E::kWorker, &Api::points},
+      {"GET", "/v1/volumes/{id}/stats", E::kInline, &Api::volume_stats},
+  };
+  return routes;
+}
+
+namespace {
+
+std::vector<std::string> segments(const std::string& path) {
+  std::vector<std::string> out;
+  size_t i = 0;
+  while (i < path.size()) {
+    if (path[i] == '/') {
+      ++i;
+      continue;
+    }
+    size_t j = path.find('/', i);
+    if (j == std::string::npos) j = path.size();
+    out.push_back(path.substr(i, j - i));
+    i = j;
+  }
+  return out;
+}
+
+bool matches(const std::vector<std::string>& tmpl, const std::vector<std::string>& path,
+             std::map<std::string, std::string>& params) {
+  if (tmpl.size() != path.size()) return false;
+  std::map<std::string, std::string> found;
+  for (size_t i = 0; i < tmpl.size(); ++i) {
+    const std::string& t = tmpl[i];
+    if (t.size() > 2 && t.front() == '{' && t.back() == '}') {
+      if (path[i].empty()) return false;
+      found[t.substr(1, t.size() - 2)] = path[i];
+    } else if (t != path[i]) {
+      return false;
+    }
+  }
+  params = std::move(found);
+  return true;
+}
+
+}  // namespace
+
+const Route* match_route(const std::string& method, const std::string& path, std::map<std::string, std::string>& params,
+                         std::vector<std::string>& allowed) {
+  const auto parts = segments(path);
+  const Route* hit = nullptr;
+  for (const Route& r : route_table()) {
+    std::map<std::string, std::string> p;
+    if (!matches(segments(r.path), parts, p)) continue;
+    allowed.push_back(r.method);
+    if (!hit && method == r.method) {
+      hit = &r;
+      params = std::move(p);
+    }
+  }
+  return hit;
+}
+
+}  // namespace solidtex::server

@@ -1,0 +1,60 @@
+// The route table and proto/openapi.json describe the same API, and the served document is
+// the file.
+#include "routes.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "openapi_document.h"
+
+namespace solidtex::server {
+namespace {
+
+std::string read_openapi_file() {
+  std::ifstream in(std::string(SOLIDTEX_SOURCE_DIR) + "/proto/openapi.json");
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+TEST(Routes, TableAndOpenApiDocumentListTheSameOperations) {
+  const auto doc = nlohmann::json::parse(read_openapi_file());
+  std::set<std::pair<std::string, std::string>> documented, routed;
+  for (auto& [path, ops] : doc["paths"].items())
+    for (auto& [method, op] : ops.items())
+      if (method != "parameters") {
+        std::string m = method;
+        for (char& c : m) c = char(std::toupper(c));
+        documented.insert({m, path});
+        EXPECT_TRUE(op.contains("operationId")) << m << " " << path;
+        EXPECT_TRUE(op.contains("responses")) << m << " " << path;
+      }
+  for (const Route& r : route_table()) routed.insert({r.method, r.path});
+  EXPECT_EQ(documented, routed);
+}
+
+TEST(Routes, ServedDocumentIsTheContractFile) { EXPECT_EQ(std::string(openapi_document()), read_openapi_file()); }
+
+TEST(Routes, MatchesTemplatesAndReportsAllowedMethods) {
+  std::map<std::string, std::string> params;
+  std::vector<std::string> allowed;
+  const Route* r = match_route("GET", "/v1/volumes/vol_1234/slice", params, allowed);
+  ASSERT_NE(r, nullptr);
+  EXPECT_STREQ(r->path, "/v1/volumes/{id}/slice");
+  EXPECT_EQ(params.at("id"), "vol_1234");
+
+  allowed.clear();
+  EXPECT_EQ(match_route("PUT", "/v1/volumes", params, allowed), nullptr);
+  EXPECT_EQ(std::set<std::string>(allowed.begin(), allowed.end()), (std::set<std::string>{"GET", "POST"}));
+
+  allowed.clear();
+  EXPECT_EQ(match_route("GET", "/v1/nothing/here", params, allowed), nullptr);
+  EXPECT_TRUE(allowed.empty());
+}
+
+}  // namespace
+}  // namespace solidtex::server

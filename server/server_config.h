@@ -1,0 +1,33 @@
+// Configuration of `solidtex serve`: a plain struct whose fields say meaning, unit, range and
+// default; validate() names the offending flag.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "image_io.h"
+#include "status.h"
+
+namespace solidtex::server {
+
+struct ServerConfig {
+  std::string host = "127.0.0.1";
+  int port = 8080;                  // [1, 65535]
+  std::string data_dir = "solidtex-data";
+  int threads = 2;                  // synthesis workers, [1, 256]
+  int io_threads = 2;               // HTTP I/O threads, [1, 64]; they never synthesize
+  int queue = 16;                   // synthesis requests waiting beyond the running ones, [0, 10000]; then 503
+  double deadline_s = 30;           // default per-request deadline, seconds, (0, max_deadline_s]
+  double max_deadline_s = 300;      // largest deadline a request may ask for, seconds, (0, 3600]
+  int64_t cache_bytes = int64_t(256) << 20;       // voxel cache over all volumes, [0, 1 TiB]
+  int64_t max_upload_bytes = int64_t(64) << 20;   // request body, bytes; beyond: 413
+  ImageLimits image_limits;         // side and pixel count, checked from the header: 422
+  int64_t max_voxels = int64_t(1) << 22;          // target voxels (output samples) per request: 422
+  int64_t max_field_nodes = int64_t(1) << 18;     // frame-field grid nodes per field: 422 beyond
+  int max_jobs = 4;                 // analysis jobs queued or running, [1, 1000]; beyond: 429
+  int analysis_threads = 1;         // analyses run at once, [1, 16]
+
+  Status validate() const;
+};
+
+}  // namespace solidtex::server

@@ -1,0 +1,20 @@
+// Encodes a box of voxel colours as an OpenVDB file in memory: one Vec3s grid named "color"
+// (linear RGB), index space = finest voxels (unit voxel size, so world = index). The only
+// server translation unit that includes OpenVDB.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "status.h"
+#include "types.h"
+
+namespace solidtex::server {
+
+// `rgb` holds size[0]*size[1]*size[2] colours, x fastest, then y, then z.
+Result<std::string> encode_vdb_box(const Voxel& min, std::array<int, 3> size,
+                                   const std::vector<std::array<float, 3>>& rgb, const std::string& volume_id);
+
+}  // namespace solidtex::server

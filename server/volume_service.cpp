@@ -1,0 +1,389 @@
+#include "volume_service.h"
+
+#include <atomic>
+#include <chrono>
+#include <deque>
+#include <map>
+#include <mutex>
+
+#include "api_json.h"
+#include "field_file.h"
+#include "json_fields.h"
+#include "region_volume.h"
+#include "synthesizer.h"
+
+namespace solidtex::server {
+
+using nlohmann::json;
+
+namespace {
+
+constexpr size_t kRecentRequests = 16;
+
+struct Volume {
+  json info;                                  // volume.json (the spec as given, plus id)
+  std::vector<std::string> exemplar_ids;      // one, or two with a region label
+  std::optional<RegionLabel> label;
+  std::shared_ptr<const FrameField> field;
+  json params_spec = json::object();          // as given; plane weights default per table
+  uint32_t seed = 1;
+  // Built at the first query.
+  std::mutex build_mutex;
+  std::vector<std::shared_ptr<Synthesizer>> synths;
+  std::shared_ptr<RegionVolume> regions;
+  // Statistics.
+  std::mutex stats_mutex;
+  std::vector<int64_t> voxels_per_level;
+  int64_t requests = 0;
+  std::deque<json> recent;
+};
+
+json stats_json(const std::string& kind, const TargetSet& target, const std::vector<SynthesisStats>& per_region,
+                double seconds) {
+  json levels = json::array();
+  int64_t voxels = 0, corrections = 0;
+  for (size_t r = 0; r < per_region.size(); ++r)
+    for (const LevelStats& l : per_region[r].levels) {
+      levels.push_back({{"region", r},
+                        {"level", l.level},
+                        {"voxels", l.voxels},
+                        {"corrections", l.corrections},
+                        {"cache_hits", l.cache_hits},
+                        {"needed_final", l.needed_final}});
+      voxels += l.voxels;
+      corrections += l.corrections;
+    }
+  return {{"kind", kind},         {"target_voxels", int64_t(target.voxels.size())},
+          {"samples", int64_t(target.sample.size())},
+          {"voxels", voxels},     {"corrections", corrections},
+          {"seconds", seconds},   {"levels", levels}};
+}
+
+}  // namespace
+
+struct VolumeService::Impl {
+  DataStore& store;
+  ServerConfig config;
+  ExemplarService& exemplars;
+  FieldService& fields;
+  mutable std::mutex mutex;
+  std::map<std::string, std::shared_ptr<Volume>> volumes;
+  std::atomic<int64_t> voxels_total{0};
+  std::vector<std::weak_ptr<Synthesizer>> live;  // every synthesizer built (guarded by mutex)
+
+  Impl(DataStore& s, const ServerConfig& c, ExemplarService& e, FieldService& f)
+      : store(s), config(c), exemplars(e), fields(f) {}
+
+  // Parses a spec (strictly) into a Volume; `field_bytes` receives the stored field to copy.
+  Result<std::shared_ptr<Volume>> parse_spec(const json& j, std::vector<uint8_t>* field_bytes, json* field_desc) {
+    SOLIDTEX_RETURN_IF_ERROR(check_keys(j, {"id", "name", "exemplar", "regions", "field", "seed", "params"}, ""));
+    auto v = std::make_shared<Volume>();
+    if (j.contains("name")) { SOLIDTEX_RETURN_IF_ERROR(json_string(j["name"], "name", 200).status()); }
+    if (j.contains("exemplar") == j.contains("regions"))
+      return Status(StatusCode::kInvalidArgument, "give exactly one of 'exemplar' and 'regions'", "exemplar");
+    if (j.contains("exemplar")) {
+      SOLIDTEX_ASSIGN_OR_RETURN(std::string e, json_string(j["exemplar"], "exemplar", 64));
+      v->exemplar_ids.push_back(e);
+    } else {
+      const json& r = j["regions"];
+      SOLIDTEX_RETURN_IF_ERROR(check_keys(r, {"exemplars", "label"}, "regions"));
+      if (!r.contains("exemplars") || !r["exemplars"].is_array() || r["exemplars"].size() != 2)
+        return Status(StatusCode::kInvalidArgument, "must be an array of two exemplar ids", "regions.exemplars");
+      for (size_t i = 0; i < 2; ++i) {
+        SOLIDTEX_ASSIGN_OR_RETURN(std::string e, json_string(r["exemplars"][i], "regions.exemplars[" + std::to_string(i) + "]", 64));
+        v->exemplar_ids.push_back(e);
+      }
+      if (!r.contains("label")) return Status(StatusCode::kInvalidArgument, "is required", "regions.label");
+      SOLIDTEX_ASSIGN_OR_RETURN(std::string label, json_string(r["label"], "regions.label"));
+      auto parsed = RegionLabel::parse(label);
+      if (!parsed) return Status(StatusCode::kInvalidArgument, parsed.status().message(), "regions.label");
+      v->label = *parsed;
+    }
+    if (j.contains("seed")) {
+      SOLIDTEX_ASSIGN_OR_RETURN(auto s, json_int(j["seed"], "seed", 0, int64_t(1) << 30));
+      v->seed = uint32_t(s);
+    }
+    if (j.contains("params")) {
+      if (!j["params"].is_object()) return Status(StatusCode::kInvalidArgument, "must be a JSON object", "params");
+      v->params_spec = j["params"];
+      SOLIDTEX_RETURN_IF_ERROR(synthesis_params_from_json(v->params_spec, "params", SynthesisParams{}).status());
+    }
+    *field_desc = json{{"kind", "identity"}};
+    std::string spec = "identity";
+    if (j.contains("field")) {
+      const json& f = j["field"];
+      SOLIDTEX_RETURN_IF_ERROR(check_keys(f, {"id", "spec", "revision"}, "field"));
+      if (f.contains("id") == f.contains("spec"))
+        return Status(StatusCode::kInvalidArgument, "give exactly one of 'id' and 'spec'", "field");
+      if (f.contains("spec")) {
+        SOLIDTEX_ASSIGN_OR_RETURN(spec, json_string(f["spec"], "field.spec"));
+        // Only the inline forms: a spec must never name a file on the server.
+        if (!(spec == "identity" || spec.rfind("identity;", 0) == 0 || spec.rfind("quat:", 0) == 0 ||
+              spec.rfind("axis:", 0) == 0))
+          return Status(StatusCode::kInvalidArgument, "must be identity, quat:W,X,Y,Z or axis:AX,AY,AZ,DEG (optionally ;scale:SX,SY,SZ)",
+                        "field.spec");
+        *field_desc = json{{"kind", "spec"}, {"spec", spec}};
+      } else {
+        SOLIDTEX_ASSIGN_OR_RETURN(std::string fid, json_string(f["id"], "field.id", 64));
+        if (field_bytes) {  // creating: copy the field's current revision
+          int revision = 0;
+          auto bytes = fields.file_bytes(fid, &revision);
+          if (!bytes) return Status(bytes.status().code(), bytes.status().message(), "field.id");
+          *field_bytes = std::move(*bytes);
+          *field_desc = json{{"kind", "stored"}, {"id", fid}, {"revision", revision}};
+        } else {
+          *field_desc = f;
+        }
+      }
+    }
+    if (spec != "identity" || !j.contains("field")) {
+      auto parsed = parse_field_spec(spec);
+      if (!parsed) return Status(StatusCode::kInvalidArgument, parsed.status().message(), "field.spec");
+      v->field = *parsed;
+    }
+    return v;
+  }
+
+  Status check_exemplars_ready(const Volume& v) {
+    for (size_t i = 0; i < v.exemplar_ids.size(); ++i) {
+      auto t = exemplars.table(v.exemplar_ids[i]);
+      if (!t) return Status(t.status().code(), t.status().message(), v.label ? "regions.exemplars" : "exemplar");
+    }
+    return Status::ok();
+  }
+
+  // Builds the synthesizers at the first query.
+  Status build(Volume& v) {
+    std::lock_guard<std::mutex> g(v.build_mutex);
+    if (!v.synths.empty()) return Status::ok();
+    std::vector<std::shared_ptr<Synthesizer>> synths;
+    for (const std::string& eid : v.exemplar_ids) {
+      SOLIDTEX_ASSIGN_OR_RETURN(auto table, exemplars.table(eid));
+      SynthesisParams base;
+      base.plane_weights = table->params().suggested_plane_weights;
+      SOLIDTEX_ASSIGN_OR_RETURN(SynthesisParams params, synthesis_params_from_json(v.params_spec, "params", base));
+      params.seed = v.seed;
+      SOLIDTEX_ASSIGN_OR_RETURN(auto s, Synthesizer::create(table, v.field, params, 0));
+      synths.push_back(s);
+    }
+    if (v.label) {
+      SOLIDTEX_ASSIGN_OR_RETURN(v.regions, RegionVolume::create(synths, *v.label));
+    }
+    v.synths = synths;
+    {
+      std::lock_guard<std::mutex> g2(mutex);
+      for (auto& s : synths) live.push_back(s);
+    }
+    rebalance_cache();
+    return Status::ok();
+  }
+
+  // Splits the cache budget evenly over every live synthesizer.
+  void rebalance_cache() {
+    const auto synths = live_synthesizers();
+    for (auto& s : synths) s->cache().set_budget_bytes(config.cache_bytes / int64_t(std::max<size_t>(1, synths.size())));
+  }
+
+  // Drops the synthesizers of deleted volumes (once their last query ended) from the list.
+  std::vector<std::shared_ptr<Synthesizer>> live_synthesizers() {
+    std::lock_guard<std::mutex> g(mutex);
+    std::vector<std::shared_ptr<Synthesizer>> out;
+    std::vector<std::weak_ptr<Synthesizer>> kept;
+    for (auto& w : live)
+      if (auto s = w.lock()) {
+        out.push_back(s);
+        kept.push_back(w);
+      }
+    live = std::move(kept);
+    return out;
+  }
+
+  Result<std::shared_ptr<Volume>> find(const std::string& id) const {
+    std::lock_guard<std::mutex> g(mutex);
+    auto it = volumes.find(id);
+    if (it == volumes.end()) return Status(StatusCode::kNotFound, "no volume '" + id + "'", "id");
+    return it->second;
+  }
+};
+
+VolumeService::VolumeService(DataStore& store, const ServerConfig& config, ExemplarService& exemplars,
+                             FieldService& fields)
+    : impl_(std::make_unique<Impl>(store, config, exemplars, fields)) {}
+VolumeService::~VolumeService() = default;
+
+Status VolumeService::start(std::vector<std::string>* report) {
+  for (const std::string& id : impl_->store.ids(ResourceKind::kVolume)) {
+    auto load = [&]() -> Result<std::shared_ptr<Volume>> {
+      SOLIDTEX_ASSIGN_OR_RETURN(std::string text, impl_->store.read_text(ResourceKind::kVolume, id, "volume.json"));
+      SOLIDTEX_ASSIGN_OR_RETURN(json info, parse_json_text(text, "volume.json"));
+      json spec = info["spec"];
+      json desc;
+      SOLIDTEX_ASSIGN_OR_RETURN(auto v, impl_->parse_spec(spec, nullptr, &desc));
+      if (info["field"].value("kind", "") == "stored") {
+        SOLIDTEX_ASSIGN_OR_RETURN(auto field, load_field(impl_->store.path(ResourceKind::kVolume, id, "field.stf")));
+        v->field = field;
+      }
+      v->info = info;
+      return v;
+    };
+    auto v = load();
+    if (!v) {
+      if (report) report->push_back("skipped volume " + id + ": " + v.status().to_string());
+      continue;
+    }
+    impl_->volumes.emplace(id, *v);
+  }
+  return Status::ok();
+}
+
+Result<json> VolumeService::create(const std::string& spec_text) {
+  SOLIDTEX_ASSIGN_OR_RETURN(json spec, parse_json_text(spec_text, "body"));
+  if (spec.contains("id")) return Status(StatusCode::kInvalidArgument, "unknown key", "id");
+  std::vector<uint8_t> field_bytes;
+  json field_desc;
+  SOLIDTEX_ASSIGN_OR_RETURN(auto v, impl_->parse_spec(spec, &field_bytes, &field_desc));
+  if (!field_bytes.empty()) {
+    SOLIDTEX_ASSIGN_OR_RETURN(auto stored, decode_field(field_bytes));
+    SOLIDTEX_ASSIGN_OR_RETURN(auto field, QuatGridField::create(stored.origin, stored.spacing, stored.dims, stored.nodes, stored.log_scales));
+    v->field = field;
+  }
+  SOLIDTEX_RETURN_IF_ERROR(impl_->check_exemplars_ready(*v));
+  const std::string id = DataStore::new_id("vol_");
+  SOLIDTEX_RETURN_IF_ERROR(impl_->store.create(ResourceKind::kVolume, id));
+  v->info = {{"id", id},
+             {"name", spec.value("name", "")},
+             {"exemplars", v->exemplar_ids},
+             {"label", spec.contains("regions") ? spec["regions"]["label"] : json("")},
+             {"field", field_desc},
+             {"field_description", v->field->describe()},
+             {"seed", v->seed},
+             {"params", v->params_spec},
+             {"spec", spec}};
+  Status st = field_bytes.empty() ? Status::ok() : impl_->store.write(ResourceKind::kVolume, id, "field.stf", field_bytes);
+  if (st.is_ok()) st = impl_->store.write_text(ResourceKind::kVolume, id, "volume.json", v->info.dump());
+  if (!st.is_ok()) {
+    impl_->store.remove(ResourceKind::kVolume, id);
+    return st;
+  }
+  std::lock_guard<std::mutex> g(impl_->mutex);
+  impl_->volumes.emplace(id, v);
+  json out = v->info;
+  out.erase("spec");
+  return out;
+}
+
+Result<json> VolumeService::get(const std::string& id) const {
+  SOLIDTEX_ASSIGN_OR_RETURN(auto v, impl_->find(id));
+  json out = v->info;
+  out.erase("spec");
+  return out;
+}
+
+json VolumeService::list() const {
+  std::lock_guard<std::mutex> g(impl_->mutex);
+  json out = json::array();
+  for (const auto& [id, v] : impl_->volumes) {
+    json j = v->info;
+    j.erase("spec");
+    out.push_back(j);
+  }
+  return {{"volumes", out}};
+}
+
+Status VolumeService::remove(const std::string& id) {
+  {
+    std::lock_guard<std::mutex> g(impl_->mutex);
+    auto it = impl_->volumes.find(id);
+    if (it == impl_->volumes.end()) return Status(StatusCode::kNotFound, "no volume '" + id + "'", "id");
+    SOLIDTEX_RETURN_IF_ERROR(impl_->store.remove(ResourceKind::kVolume, id));
+    impl_->volumes.erase(it);  // running queries keep their shared_ptr until they finish
+  }
+  impl_->rebalance_cache();
+  return Status::ok();
+}
+
+bool VolumeService::uses_exemplar(const std::string& exemplar_id) const {
+  std::lock_guard<std::mutex> g(impl_->mutex);
+  for (const auto& [id, v] : impl_->volumes)
+    for (const auto& e : v->exemplar_ids)
+      if (e == exemplar_id) return true;
+  return false;
+}
+
+Status VolumeService::check_target_size(int64_t samples, const std::string& field) const {
+  if (samples > impl_->config.max_voxels)
+    return Status(StatusCode::kUnprocessable,
+                  "asks for " + std::to_string(samples) + " samples; the limit per request is " +
+                      std::to_string(impl_->config.max_voxels) + " (--max-voxels)",
+                  field);
+  return Status::ok();
+}
+
+Result<QueryResult> VolumeService::query(const std::string& id, const std::string& kind, const TargetSet& target,
+                                         Interrupter& interrupter) {
+  SOLIDTEX_RETURN_IF_ERROR(check_target_size(int64_t(target.sample.size()), "size"));
+  SOLIDTEX_ASSIGN_OR_RETURN(auto v, impl_->find(id));
+  SOLIDTEX_RETURN_IF_ERROR(impl_->build(*v));
+  const auto t0 = std::chrono::steady_clock::now();
+  std::vector<SynthesisStats> per_region;
+  QueryResult out;
+  if (v->regions) {
+    SOLIDTEX_ASSIGN_OR_RETURN(out.rgb, v->regions->synthesize(target, interrupter, &per_region));
+  } else {
+    per_region.resize(1);
+    SOLIDTEX_ASSIGN_OR_RETURN(out.rgb, v->synths[0]->synthesize(target, interrupter, &per_region[0]));
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  for (const SynthesisStats& s : per_region) out.voxels_synthesized += s.voxels;
+  impl_->voxels_total += out.voxels_synthesized;
+  std::lock_guard<std::mutex> g(v->stats_mutex);
+  ++v->requests;
+  for (const SynthesisStats& s : per_region)
+    for (const LevelStats& l : s.levels) {
+      if (v->voxels_per_level.size() <= size_t(l.level)) v->voxels_per_level.resize(size_t(l.level) + 1, 0);
+      v->voxels_per_level[size_t(l.level)] += l.voxels;
+    }
+  v->recent.push_back(stats_json(kind, target, per_region, seconds));
+  if (v->recent.size() > kRecentRequests) v->recent.pop_front();
+  return out;
+}
+
+Result<json> VolumeService::stats(const std::string& id) const {
+  SOLIDTEX_ASSIGN_OR_RETURN(auto v, impl_->find(id));
+  std::vector<std::shared_ptr<Synthesizer>> synths;
+  {
+    std::lock_guard<std::mutex> g(v->build_mutex);
+    synths = v->synths;
+  }
+  json cache = {{"bytes", 0}, {"budget_bytes", 0}, {"hits", 0}, {"misses", 0}, {"bricks", 0}, {"evicted_bricks", 0}};
+  std::vector<int64_t> cached;
+  for (const auto& s : synths) {
+    const VoxelCache::Counters c = s->cache().counters();
+    cache["bytes"] = cache["bytes"].get<int64_t>() + c.bytes;
+    cache["budget_bytes"] = cache["budget_bytes"].get<int64_t>() + s->cache().budget_bytes();
+    cache["hits"] = cache["hits"].get<int64_t>() + c.hits;
+    cache["misses"] = cache["misses"].get<int64_t>() + c.misses;
+    cache["bricks"] = cache["bricks"].get<int64_t>() + c.bricks;
+    cache["evicted_bricks"] = cache["evicted_bricks"].get<int64_t>() + c.evicted_bricks;
+    if (cached.size() < c.voxels_per_level.size()) cached.resize(c.voxels_per_level.size(), 0);
+    for (size_t l = 0; l < c.voxels_per_level.size(); ++l) cached[l] += c.voxels_per_level[l];
+  }
+  std::lock_guard<std::mutex> g(v->stats_mutex);
+  json levels = json::array();
+  for (size_t l = 0; l < std::max(cached.size(), v->voxels_per_level.size()); ++l)
+    levels.push_back({{"level", l},
+                      {"voxels_synthesized", l < v->voxels_per_level.size() ? v->voxels_per_level[l] : 0},
+                      {"cached_voxels", l < cached.size() ? cached[l] : 0}});
+  return json{{"volume", id}, {"levels", levels}, {"cache", cache}, {"requests", v->requests},
+              {"recent", json(std::vector<json>(v->recent.begin(), v->recent.end()))}};
+}
+
+int64_t VolumeService::cache_bytes() const {
+  int64_t bytes = 0;
+  for (auto& s : impl_->live_synthesizers()) bytes += s->cache().counters().bytes;
+  return bytes;
+}
+
+int64_t VolumeService::voxels_synthesized() const { return impl_->voxels_total.load(); }
+
+}  // namespace solidtex::server

@@ -1,0 +1,249 @@
+"""Helpers for the end-to-end tests: starting `solidtex serve`, running the CLI, small checks."""
+from __future__ import annotations
+
+import io
+import json
+import os
+import select
+import signal
+import socket
+import struct
+import subprocess
+import sys
+import time
+import zlib
+from pathlib import Path
+from typing import Any, Dict, Iterable, List, Optional, Sequence
+
+import numpy as np
+import requests
+
+REPO = Path(__file__).resolve().parents[2]
+CLIENT_DIR = REPO / "client"
+if str(CLIENT_DIR) not in sys.path:
+    sys.path.insert(0, str(CLIENT_DIR))
+
+from solidtex_client import Client  # noqa: E402
+
+# Small analyses keep the suite fast on 2 cores; the CLI gets the same values.
+ANALYSIS = {"levels": 3, "neighborhood": 5, "candidates": 4, "pca_dims": 8}
+ANALYSIS_CLI = ["--levels", "3", "--neighborhood", "5", "--candidates", "4", "--pca-dims", "8"]
+HTTP_TIMEOUT = 120
+
+
+def solidtex_bin() -> Path:
+    return Path(os.environ.get("SOLIDTEX_BIN", str(REPO / "build" / "bin" / "solidtex")))
+
+
+def free_port() -> int:
+    """A TCP port on 127.0.0.1 that was free a moment ago."""
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def run_cli(*args: Any, timeout: float = 300) -> subprocess.CompletedProcess:
+    """Run the solidtex executable; fails the test with its output if it exits non-zero."""
+    cmd = [str(solidtex_bin())] + [str(a) for a in args]
+    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
+    if proc.returncode != 0:
+        raise AssertionError(f"{' '.join(cmd)} exited {proc.returncode}\n"
+                             f"stdout:\n{proc.stdout}\nstderr:\n{proc.stderr}")
+    return proc
+
+
+class Server:
+    """One running `solidtex serve` process."""
+
+    def __init__(self, binary: Path, data_dir: Path, log_path: Path, flags: Sequence[str],
+                 port: Optional[int] = None) -> None:
+        self.data_dir = Path(data_dir)
+        self.data_dir.mkdir(parents=True, exist_ok=True)
+        self.log_path = log_path
+        self.flags = [str(f) for f in flags]
+        self.port = port or free_port()
+        self.url = f"http://127.0.0.1:{self.port}"
+        self.cmd = [str(binary), "serve", "--host", "127.0.0.1", "--port", str(self.port),
+                    "--data", str(self.data_dir)] + self.flags
+        self._log = open(log_path, "wb")
+        self.proc = subprocess.Popen(self.cmd, stdout=self._log, stderr=subprocess.STDOUT)
+        self.client = Client(self.url, timeout=HTTP_TIMEOUT)
+        try:
+            self._wait_healthy(30.0)
+        except BaseException:
+            self.kill()
+            raise
+
+    def _wait_healthy(self, seconds: float) -> None:
+        end = time.monotonic() + seconds
+        last = ""
+        while time.monotonic() < end:
+            if self.proc.poll() is not None:
+                raise AssertionError(f"server exited with {self.proc.returncode} before it was "
+                                     f"healthy: {' '.join(self.cmd)}\n{self.log()}")
+            try:
+                r = requests.get(self.url + "/healthz", timeout=2)
+                if r.status_code == 200:
+                    return
+                last = f"status {r.status_code}"
+            except requests.RequestException as e:
+                last = str(e)
+            time.sleep(0.05)
+        raise AssertionError(f"server not healthy after {seconds} s ({last}): "
+                             f"{' '.join(self.cmd)}\n{self.log()}")
+
+    def log(self, tail: int = 4000) -> str:
+        try:
+            self._log.flush()
+            return self.log_path.read_bytes()[-tail:].decode("utf-8", "replace")
+        except OSError:
+            return ""
+
+    @property
+    def running(self) -> bool:
+        return self.proc.poll() is None
+
+    def stop(self, grace: float = 10.0) -> Optional[int]:
+        """SIGTERM, then SIGKILL after ``grace`` seconds; returns the exit code."""
+        if self.proc.poll() is None:
+            self.proc.send_signal(signal.SIGTERM)
+            try:
+                self.proc.wait(grace)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                self.proc.wait(10)
+        self._close()
+        return self.proc.returncode
+
+    def kill(self) -> None:
+        """kill -9."""
+        if self.proc.poll() is None:
+            self.proc.kill()
+            self.proc.wait(10)
+        self._close()
+
+    def _close(self) -> None:
+        self.client.close()
+        if not self._log.closed:
+            self._log.close()
+
+
+class ServerFactory:
+    """Starts servers (``start(*flags, data_dir=None)``) and stops them all at ``close()``."""
+
+    def __init__(self, base_dir: Path) -> None:
+        self.base_dir = Path(base_dir)
+        self.base_dir.mkdir(parents=True, exist_ok=True)
+        self.servers: List[Server] = []
+
+    def start(self, *flags: Any, data_dir: Optional[Path] = None) -> Server:
+        binary = solidtex_bin()
+        n = len(self.servers)
+        if data_dir is None:
+            data_dir = self.base_dir / f"data{n}"
+        log = self.base_dir / f"server{n}.log"
+        server = Server(binary, Path(data_dir), log, [str(f) for f in flags])
+        self.servers.append(server)
+        return server
+
+    __call__ = start
+
+    def close(self) -> None:
+        for s in reversed(self.servers):
+            s.stop()
+
+
+def upload_ready(client: Client, image: Any, **params: Any) -> Dict[str, Any]:
+    """Upload with the small analysis parameters, wait for the job; returns the exemplar."""
+    up = client.upload_exemplar(image, **{**ANALYSIS, **params})
+    client.wait_for_job(up["job"]["id"], timeout=120, poll=0.1)
+    return client.get_exemplar(up["exemplar"]["id"])
+
+
+def png_pixels(data: bytes) -> np.ndarray:
+    from PIL import Image
+    img = Image.open(io.BytesIO(data))
+    img.load()
+    return np.asarray(img.convert("RGB"))
+
+
+def file_pixels(path: Path) -> np.ndarray:
+    return png_pixels(Path(path).read_bytes())
+
+
+def assert_error(response: requests.Response, status: int, code: Optional[str] = None,
+                 field_contains: Optional[str] = None) -> Dict[str, Any]:
+    """The answer has ``status`` and the documented error body; returns the error object."""
+    assert response.status_code == status, (
+        f"expected {status}, got {response.status_code}: {response.text[:500]}")
+    assert response.headers.get("Content-Type", "").startswith("application/json"), \
+        response.headers.get("Content-Type")
+    body = response.json()
+    assert set(body) == {"error"}, body
+    err = body["error"]
+    for key in ("code", "message", "field"):
+        assert isinstance(err.get(key), str), f"error.{key} missing or not a string: {body}"
+    assert err["code"], body
+    assert err["message"], body
+    if code is not None:
+        assert err["code"] == code, body
+    if field_contains is not None:
+        assert field_contains in err["field"], body
+    return err
+
+
+def png_with_header(width: int, height: int) -> bytes:
+    """A tiny PNG whose IHDR claims width x height (RGB8), with valid CRCs and one IDAT."""
+    def chunk(kind: bytes, data: bytes) -> bytes:
+        return (struct.pack(">I", len(data)) + kind + data
+                + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF))
+    ihdr = struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr)
+            + chunk(b"IDAT", zlib.compress(b"\x00" * 64)) + chunk(b"IEND", b""))
+
+
+def raw_post(url: str, path: str, body: bytes, content_type: str = "application/octet-stream",
+             timeout: float = 30.0) -> int:
+    """POST ``body`` over a plain socket, stopping the upload as soon as the server answers
+    (a server may reject an oversized body before reading it). Returns the status code."""
+    host, port = url.split("//", 1)[1].split(":")
+    sock = socket.create_connection((host, int(port)), timeout=timeout)
+    try:
+        head = (f"POST {path} HTTP/1.1\r\nHost: {host}:{port}\r\nContent-Type: {content_type}\r\n"
+                f"Content-Length: {len(body)}\r\nConnection: close\r\n\r\n").encode()
+        sock.sendall(head)
+        sent, answer = 0, b""
+        end = time.monotonic() + timeout
+        while sent < len(body) and time.monotonic() < end:
+            readable, _, _ = select.select([sock], [], [], 0)
+            if readable:
+                break
+            try:
+                sent += sock.send(body[sent:sent + 65536])
+            except (BrokenPipeError, ConnectionResetError):
+                break
+        while time.monotonic() < end and b"\r\n" not in answer:
+            try:
+                chunk = sock.recv(65536)
+            except ConnectionResetError:
+                break
+            if not chunk:
+                break
+            answer += chunk
+        line = answer.split(b"\r\n", 1)[0].decode("latin-1")
+        if not line.startswith("HTTP/"):
+            raise AssertionError(f"no HTTP answer (sent {sent} of {len(body)} bytes): {answer[:200]!r}")
+        return int(line.split()[1])
+    finally:
+        sock.close()
+
+
+def metric_lines(text: str, name: str) -> List[str]:
+    """Sample lines of metric ``name`` (``name`` or ``name{...}`` followed by a value)."""
+    out = []
+    for line in text.splitlines():
+        if line.startswith("#"):
+            continue
+        if line.startswith(name + " ") or line.startswith(name + "{"):
+            out.append(line)
+    return out

@@ -1,0 +1,73 @@
+"""The Python client's command line against a running server."""
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+from PIL import Image
+
+from support import CLIENT_DIR, file_pixels
+
+
+def client_cli(url, *args, check=True):
+    env = dict(os.environ)
+    env["PYTHONPATH"] = str(CLIENT_DIR) + os.pathsep + env.get("PYTHONPATH", "")
+    proc = subprocess.run([sys.executable, "-m", "solidtex_client.cli", "--url", url,
+                           *[str(a) for a in args]], capture_output=True, text=True, env=env,
+                          timeout=300)
+    if check:
+        assert proc.returncode == 0, f"exit {proc.returncode}\n{proc.stdout}\n{proc.stderr}"
+    return proc
+
+
+def test_cli_slice_writes_png(shared, tmp_path):
+    out = tmp_path / "out.png"
+    client_cli(shared.server.url, "slice", shared.volume_id, "--axis", "z", "--at", "0",
+               "--size", "16,16", "-o", out)
+    img = Image.open(out)
+    assert img.format == "PNG" and img.size == (16, 16)
+    assert np.array_equal(file_pixels(out), shared.client.slice(shared.volume_id, "z", 0, (16, 16)))
+
+
+def test_cli_error_message_and_status(shared, tmp_path):
+    proc = client_cli(shared.server.url, "slice", "no-such-volume", "--axis", "z", "--at", "0",
+                      "--size", "16,16", "-o", tmp_path / "x.png", check=False)
+    assert proc.returncode == 1
+    assert proc.stderr.startswith("error: not_found: "), proc.stderr
+    assert not (tmp_path / "x.png").exists()
+
+
+def test_cli_upload_field_volume_region_points(shared, exemplars, tmp_path):
+    url = shared.server.url
+    up = json.loads(client_cli(url, "upload", exemplars["bricks"], "--levels", "3",
+                               "--neighborhood", "5", "--candidates", "4", "--pca-dims", "8",
+                               "--name", "bricks", "--wait").stdout)
+    assert up["exemplar"]["state"] == "ready" and up["job"]["state"] == "succeeded"
+    sketch = tmp_path / "s.json"
+    sketch.write_text(json.dumps({
+        "domain": {"min": [0, 0, 0], "max": [16, 16, 16], "shortest_side_cells": 4},
+        "curves": [{"points": [[2, 8, 8], [14, 8, 8]], "plane_normal": [0, 0, 1]}]}))
+    fld = json.loads(client_cli(url, "field", sketch).stdout)
+    assert fld["revision"] == 1
+    vol = json.loads(client_cli(url, "volume", "--exemplar", up["exemplar"]["id"],
+                                "--field-id", fld["id"], "--seed", "4").stdout)
+    assert vol["seed"] == 4
+
+    npy = tmp_path / "box.npy"
+    client_cli(url, "region", vol["id"], "--min", "0,0,0", "--size", "6,5,4", "-o", npy)
+    box = np.load(npy)
+    assert box.shape == (4, 5, 6, 3) and box.dtype == np.float32
+    vdb = tmp_path / "box.vdb"
+    client_cli(url, "region", vol["id"], "--min", "0,0,0", "--size", "6,5,4", "-o", vdb)
+    assert vdb.read_bytes()[:4] == b" BDV"
+
+    pts = tmp_path / "pts.txt"
+    pts.write_text("0 0 0\n5,4,3\n2 1 0\n")
+    out = tmp_path / "rgb.npy"
+    client_cli(url, "points", vol["id"], pts, "-o", out)
+    rgb = np.load(out)
+    assert rgb.shape == (3, 3)
+    assert np.array_equal(rgb[0], box[0, 0, 0])
+    assert np.array_equal(rgb[1], box[3, 4, 5])
+    assert np.array_equal(rgb[2], box[0, 1, 2])

@@ -1,0 +1,82 @@
+"""Exemplar upload, background analysis, table download and bit identity with the CLI."""
+import numpy as np
+import requests
+
+from support import ANALYSIS, ANALYSIS_CLI, file_pixels, run_cli
+from solidtex_client import encode_png
+
+
+def test_upload_analyse_download_matches_cli(shared, exemplars, cli_table):
+    c = shared.client
+    r = requests.post(shared.server.url + "/v1/exemplars", params={**ANALYSIS, "name": "wood2"},
+                      data=exemplars["wood"].read_bytes(),
+                      headers={"Content-Type": "application/octet-stream"}, timeout=60)
+    assert r.status_code == 202, r.text
+    assert r.headers.get("Location"), r.headers
+    body = r.json()
+    ex, job = body["exemplar"], body["job"]
+    assert ex["id"] and job["id"]
+    assert job["kind"] == "analysis"
+    assert job["state"] in ("queued", "running", "succeeded")
+    assert 0 <= job["percent"] <= 100
+    assert ex["state"] in ("analyzing", "ready")
+
+    final = c.wait_for_job(job["id"], timeout=120, poll=0.1)
+    assert final["state"] == "succeeded"
+    assert final["percent"] == 100
+    assert final.get("error") is None
+    if "exemplar_id" in final:
+        assert final["exemplar_id"] == ex["id"]
+
+    got = c.get_exemplar(ex["id"])
+    assert got["id"] == ex["id"]
+    assert got["state"] == "ready"
+    assert got["name"] == "wood2"
+    assert got["planes"] == 1
+    assert (got["width"], got["height"]) == (64, 64)
+    assert got.get("has_mask") in (None, False)
+    levels = got["levels"]
+    assert len(levels) == 3
+    for lv in levels:
+        assert lv["mean_crossbar_error"] < lv["random_crossbar_error"], lv
+
+    assert ex["id"] in [e["id"] for e in c.list_exemplars()]
+
+    table = c.get_exemplar_table(ex["id"])
+    assert table[:8] == b"STXTABLE"
+    if "table_bytes" in got:
+        assert got["table_bytes"] == len(table)
+    assert table == cli_table.read_bytes(), "service table differs from `solidtex analyze`"
+    # the shared fixture's upload of the same image gives the same table too
+    assert shared.table == table
+
+
+def test_three_planes_multipart_matches_cli(shared, exemplars, tmp_path):
+    c = shared.client
+    up = c.upload_exemplar(exemplars["wood"], yz=exemplars["stripes"], zx=exemplars["bricks"],
+                           **ANALYSIS)
+    assert c.last_response.status_code == 202
+    c.wait_for_job(up["job"]["id"], timeout=120, poll=0.1)
+    got = c.get_exemplar(up["exemplar"]["id"])
+    assert got["state"] == "ready"
+    assert got["planes"] == 3
+    cli = tmp_path / "three.stx"
+    run_cli("analyze", exemplars["wood"], "--yz", exemplars["stripes"], "--zx", exemplars["bricks"],
+            *ANALYSIS_CLI, "-o", cli)
+    assert c.get_exemplar_table(got["id"]) == cli.read_bytes()
+
+
+def test_numpy_upload_is_sent_as_png(shared, exemplars, tmp_path):
+    c = shared.client
+    pixels = file_pixels(exemplars["noise"])
+    assert pixels.dtype == np.uint8 and pixels.shape == (64, 64, 3)
+    up = c.upload_exemplar(pixels, name="noise-array", **ANALYSIS)
+    c.wait_for_job(up["job"]["id"], timeout=120, poll=0.1)
+    got = c.get_exemplar(up["exemplar"]["id"])
+    assert got["state"] == "ready" and (got["width"], got["height"]) == (64, 64)
+    # the CLI analysing the same PNG bytes the client sent gives the same table
+    png = tmp_path / "noise-array.png"
+    png.write_bytes(encode_png(pixels))
+    cli = tmp_path / "noise.stx"
+    run_cli("analyze", png, *ANALYSIS_CLI, "-o", cli)
+    assert c.get_exemplar_table(got["id"]) == cli.read_bytes()

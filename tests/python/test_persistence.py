@@ -1,0 +1,89 @@
+"""Persistence: everything acknowledged survives kill -9 and SIGTERM; leftovers are ignored."""
+import os
+import time
+
+import numpy as np
+import pytest
+
+from support import ANALYSIS, ANALYSIS_CLI, run_cli, upload_ready
+
+pytestmark = pytest.mark.slow
+
+SKETCH = {
+    "domain": {"min": [0, 0, 0], "max": [32, 32, 32], "shortest_side_cells": 8},
+    "curves": [{"points": [[4, 4, 16], [28, 28, 16]], "plane_normal": [0, 0, 1], "axis": "x"}],
+}
+
+
+def wait_ready(client, exemplar_id, seconds=90):
+    end = time.monotonic() + seconds
+    while True:
+        ex = client.get_exemplar(exemplar_id)
+        if ex["state"] != "analyzing" or time.monotonic() > end:
+            return ex
+        time.sleep(0.1)
+
+
+def test_kill9_restart_keeps_everything(server, exemplars, tmp_path):
+    a = server()
+    c = a.client
+    ex = upload_ready(c, exemplars["wood"], name="wood")
+    fld = c.create_field(SKETCH)
+    vol = c.create_volume(exemplar=ex["id"], field={"id": fld["id"]}, seed=3, name="v")
+    png = c.slice(vol["id"], "z", 5, (24, 16), dtype="png_bytes")
+    raw = c.slice(vol["id"], "y", 2, (24, 16), origin=(-5, 1))
+    table = c.get_exemplar_table(ex["id"])
+    stf = c.get_field_file(fld["id"])
+    volume_before = c.get_volume(vol["id"])
+    # acknowledged, then the server dies before (or while) analysing it
+    pending = c.upload_exemplar(exemplars["spots"], name="pending", **ANALYSIS)
+    assert c.last_response.status_code == 202
+    a.kill()
+
+    # leftovers of interrupted writes: junk and half-written copies of real files
+    files = [p for p in a.data_dir.rglob("*") if p.is_file()]
+    assert files, "the server stored nothing in its data directory"
+    for d in {a.data_dir, *(p.parent for p in files)}:
+        (d / "leftover.tmp").write_bytes(os.urandom(100))
+    for p in files:
+        data = p.read_bytes()
+        p.with_name(p.name + ".tmp").write_bytes(data[: len(data) // 2])
+
+    b = server(data_dir=a.data_dir)
+    c = b.client
+    assert {ex["id"], pending["exemplar"]["id"]} <= {e["id"] for e in c.list_exemplars()}
+    assert fld["id"] in [f["id"] for f in c.list_fields()]
+    assert vol["id"] in [v["id"] for v in c.list_volumes()]
+    assert c.get_exemplar(ex["id"])["state"] == "ready"
+    assert c.get_exemplar(ex["id"])["name"] == "wood"
+    assert c.get_field(fld["id"])["revision"] == 1
+    assert c.get_volume(vol["id"]) == volume_before
+    assert c.get_exemplar_table(ex["id"]) == table
+    assert c.get_field_file(fld["id"]) == stf
+    assert c.slice(vol["id"], "z", 5, (24, 16), dtype="png_bytes") == png
+    assert np.array_equal(c.slice(vol["id"], "y", 2, (24, 16), origin=(-5, 1)), raw)
+
+    # the acknowledged upload is analysed after the restart
+    got = wait_ready(c, pending["exemplar"]["id"])
+    assert got["state"] == "ready", got
+    assert got["name"] == "pending"
+    job_id = got.get("job_id") or pending["job"]["id"]
+    job = c.wait_for_job(job_id, timeout=60, poll=0.1)
+    assert job["state"] == "succeeded" and job["percent"] == 100
+    cli = tmp_path / "spots.stx"
+    run_cli("analyze", exemplars["spots"], *ANALYSIS_CLI, "-o", cli)
+    assert c.get_exemplar_table(got["id"]) == cli.read_bytes()
+
+
+def test_sigterm_exits_cleanly_and_restarts(server, exemplars):
+    a = server()
+    ex = upload_ready(a.client, exemplars["stripes"])
+    vol = a.client.create_volume(exemplar=ex["id"], field="axis:0,0,1,30", seed=2)
+    before = a.client.slice(vol["id"], "z", 1, (16, 16))
+    t0 = time.monotonic()
+    code = a.stop(grace=10)
+    assert time.monotonic() - t0 < 10, "SIGTERM did not stop the server within 10 s"
+    assert code == 0, f"exit status {code} after SIGTERM\n{a.log()}"
+    b = server(data_dir=a.data_dir)
+    assert b.client.get_exemplar(ex["id"])["state"] == "ready"
+    assert np.array_equal(b.client.slice(vol["id"], "z", 1, (16, 16)), before)

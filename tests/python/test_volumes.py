@@ -1,0 +1,157 @@
+"""Volumes: slices, cuts, caching, and bit identity across request kinds and with the CLI.
+
+Each test reads its own far-apart part of the shared volume so that caching by one test does
+not hide synthesis in another.
+"""
+import numpy as np
+import requests
+
+from support import assert_error, file_pixels, png_pixels, run_cli
+
+RAW = {"Accept": "application/octet-stream"}
+RAW_F32 = {"Accept": "application/octet-stream; dtype=float32"}
+OBLIQUE = dict(origin=(1, 2, 3), u=(0.6, 0.8, 0), v=(-0.48, 0.36, 0.8), size=(32, 24))
+
+
+def srgb8(linear: np.ndarray) -> np.ndarray:
+    x = np.clip(linear.astype(np.float64), 0, 1)
+    s = np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(x, 1 / 2.4) - 0.055)
+    return np.round(s * 255)
+
+
+def test_create_get_delete_volume(shared):
+    url = shared.server.url
+    r = requests.post(url + "/v1/volumes", json={"exemplar": shared.exemplar_id, "seed": 11,
+                                                  "name": "tmp"}, timeout=60)
+    assert r.status_code == 201, r.text
+    assert r.headers.get("Location")
+    vol = r.json()
+    assert vol["id"] and vol["seed"] == 11 and vol["name"] == "tmp"
+    assert vol["exemplars"] == [shared.exemplar_id]
+    c = shared.client
+    assert c.get_volume(vol["id"])["id"] == vol["id"]
+    assert vol["id"] in [v["id"] for v in c.list_volumes()]
+    r = requests.delete(f"{url}/v1/volumes/{vol['id']}", timeout=60)
+    assert r.status_code == 204
+    assert_error(requests.get(f"{url}/v1/volumes/{vol['id']}", timeout=60), 404, "not_found")
+    assert vol["id"] not in [v["id"] for v in c.list_volumes()]
+    assert shared.volume_id in [v["id"] for v in c.list_volumes()]
+
+
+def test_slice_variants_agree_and_match_cli(shared, tmp_path):
+    c, vid = shared.client, shared.volume_id
+    u8 = c.slice(vid, "z", 3, (32, 24))
+    assert c.last_response.headers["X-Shape"].replace(" ", "") == "24,32,3"
+    assert u8.dtype == np.uint8 and u8.shape == (24, 32, 3)
+    assert u8.std() > 1.0, "slice is constant"
+    f32 = c.slice(vid, "z", 3, (32, 24), dtype="float32")
+    assert f32.dtype == np.float32 and f32.shape == (24, 32, 3)
+    assert np.all(np.isfinite(f32))
+    assert np.abs(srgb8(f32) - u8).max() <= 1, "uint8 answer is not the sRGB encoding of float32"
+    png = c.slice(vid, "z", 3, (32, 24), dtype="png_bytes")
+    assert c.last_response.headers["Content-Type"].startswith("image/png")
+    assert png[:8] == b"\x89PNG\r\n\x1a\n"
+    assert np.array_equal(png_pixels(png), u8)
+    img = c.slice(vid, "z", 3, (32, 24), dtype="png")
+    assert img.size == (32, 24)
+
+    out = tmp_path / "cli.png"
+    run_cli("slice", shared.table_path, "--axis", "z", "--at", "3", "--size", "32,24",
+            "--seed", "7", "-o", out)
+    assert np.array_equal(file_pixels(out), png_pixels(png)), "service slice != CLI slice"
+
+
+def test_default_answer_is_png(shared):
+    r = requests.get(f"{shared.server.url}/v1/volumes/{shared.volume_id}/slice",
+                     params={"axis": "z", "at": 3, "size": "32,24"}, timeout=60)
+    assert r.status_code == 200
+    assert r.headers["Content-Type"].startswith("image/png")
+    assert np.array_equal(png_pixels(r.content), shared.client.slice(shared.volume_id, "z", 3, (32, 24)))
+
+
+def test_other_axes(shared):
+    c, vid = shared.client, shared.volume_id
+    x = c.slice(vid, "x", 5, (20, 12), origin=(-3, 4), dtype="float32")
+    y = c.slice(vid, "y", 4, (20, 12), origin=(5, -2), dtype="float32")
+    assert x.shape == y.shape == (12, 20, 3)
+    # pixel (i, j) (array [j, i]) of axis x is voxel (at, U+i, V+j), of axis y (U+i, at, V+j):
+    # voxel (5, 4, 6) is x[2, 7] and y[8, 0]; voxel (5, 10, 9) is x[5, 13]
+    assert np.array_equal(x[2, 7], y[8, 0])
+    p = c.points(vid, [[5, 4, 6], [5, 10, 9]])
+    assert np.array_equal(p[0], x[2, 7])
+    assert np.array_equal(p[1], x[5, 13])
+
+
+def test_repeated_slice_is_cached(shared):
+    url = f"{shared.server.url}/v1/volumes/{shared.volume_id}/slice"
+    params = {"axis": "z", "at": 61, "origin": "400,400", "size": "16,16"}
+    r1 = requests.get(url, params=params, headers=RAW, timeout=60)
+    assert r1.status_code == 200, r1.text
+    assert int(r1.headers["X-Voxels-Synthesized"]) > 0
+    r2 = requests.get(url, params=params, headers=RAW, timeout=60)
+    assert r2.status_code == 200
+    assert r2.content == r1.content
+    assert r2.headers["X-Voxels-Synthesized"].strip() == "0"
+    stats = shared.client.volume_stats(shared.volume_id)
+    assert stats["cache"]["hits"] > 0, stats
+    assert stats["cache"]["bytes"] > 0, stats
+    if "volume" in stats:
+        assert stats["volume"] == shared.volume_id
+    assert sum(lv["voxels_synthesized"] for lv in stats["levels"]) > 0, stats
+
+
+def test_cut_matches_cli_plane_and_slice(shared, tmp_path):
+    c, vid = shared.client, shared.volume_id
+    png = c.cut(vid, dtype="png_bytes", **OBLIQUE)
+    u8 = c.cut(vid, **OBLIQUE)
+    assert u8.shape == (24, 32, 3) and u8.std() > 1.0
+    assert np.array_equal(png_pixels(png), u8)
+    out = tmp_path / "c.png"
+    plane = ",".join(str(x) for x in (*OBLIQUE["origin"], *OBLIQUE["u"], *OBLIQUE["v"]))
+    run_cli("slice", shared.table_path, "--plane", plane, "--size", "32,24", "--seed", "7",
+            "-o", out)
+    assert np.array_equal(file_pixels(out), u8), "service cut != CLI --plane"
+    # an axis-aligned cut is the slice
+    flat = c.cut(vid, origin=(0, 0, 3), u=(1, 0, 0), v=(0, 1, 0), size=(32, 24), dtype="float32")
+    assert np.array_equal(flat, c.slice(vid, "z", 3, (32, 24), dtype="float32"))
+
+
+def test_points_region_slice_agree(shared):
+    c, vid = shared.client, shared.volume_id
+    x0, y0, z0 = 200, -40, 30
+    w, h, d = 12, 8, 3
+    k = z0 + 1
+    row = 5
+    pts = np.array([[x0 + i, y0 + row, k] for i in range(w)], dtype=np.float64)
+    p = c.points(vid, pts)                      # first: nothing of this box is cached yet
+    assert p.shape == (w, 3) and p.dtype == np.float32
+    assert c.last_response.headers["X-Shape"].replace(" ", "") == f"{w},3"
+    box = c.region(vid, (x0, y0, z0), (w, h, d), fmt="float32")
+    assert box.shape == (d, h, w, 3)
+    assert c.last_response.headers["X-Shape"].replace(" ", "") == f"{d},{h},{w},3"
+    sl = c.slice(vid, "z", k, (w, h), origin=(x0, y0), dtype="float32")
+    assert np.array_equal(p, sl[row]), "points != slice pixels"
+    assert np.array_equal(box[k - z0], sl), "region != slice of the same plane"
+    box8 = c.region(vid, (x0, y0, z0), (w, h, d), fmt="uint8")
+    assert box8.dtype == np.uint8 and box8.shape == (d, h, w, 3)
+    assert np.array_equal(box8[k - z0], c.slice(vid, "z", k, (w, h), origin=(x0, y0)))
+    # world points round to the nearest voxel
+    assert np.array_equal(c.points(vid, pts + [0.3, -0.3, 0.2]), p)
+    # JSON variant
+    r = requests.post(f"{shared.server.url}/v1/volumes/{vid}/points",
+                      json={"points": pts.tolist()}, headers={"Accept": "application/json"},
+                      timeout=60)
+    assert r.status_code == 200, r.text
+    assert np.array_equal(np.asarray(r.json()["rgb"], dtype=np.float32), p)
+
+
+def test_region_default_is_vdb(shared):
+    c, vid = shared.client, shared.volume_id
+    data = c.region(vid, (-8, 60, 0), (8, 8, 8))
+    assert isinstance(data, bytes) and len(data) > 64
+    assert data[:4] == b" BDV", data[:16]
+    r = requests.get(f"{shared.server.url}/v1/volumes/{vid}/region",
+                     params={"min": "-8,60,0", "size": "8,8,8"}, timeout=60)
+    assert r.status_code == 200
+    assert r.headers["Content-Type"].startswith("application/x-vdb")
+    assert r.content[:4] == b" BDV"
