@@ -3,7 +3,7 @@ BUILD_DIR ?= build
 JOBS ?= $(shell nproc)
 PORT ?= 8080
 
-.PHONY: deps configure build test serve bench clean
+.PHONY: deps configure build python test serve bench clean
 
 deps:
 	@scripts/install-deps.sh
@@ -14,7 +14,10 @@ configure: deps
 build: configure
 	@cmake --build $(BUILD_DIR) -j $(JOBS)
 
-test: build
+python: deps
+	@scripts/setup-python.sh $(abspath $(BUILD_DIR))
+
+test: build python
 	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
 
 serve: build

@@ -1,16 +1,58 @@
 #!/usr/bin/env bash
-# `make serve`: builds a demo from exemplars solidtex generates itself (no download): a
-# spots table and a cut through it. (The HTTP service arrives with issue #5; until then this is
-# the demo.)
+# `make serve`: starts `solidtex serve` on PORT with a ready demo volume made from an exemplar
+# solidtex generates itself (no download), prints URLs to try, and keeps serving until Ctrl-C.
+# The demo data live in BUILD/demo-data and survive restarts (the demo is created once).
 set -euo pipefail
 build=${1:-build}
-demo=${SOLIDTEX_DEMO_DIR:-$build/demo}
-mkdir -p "$demo"
-"$build/bin/solidtex" exemplar spots --size 64,64 -o "$demo/spots.png"
-"$build/bin/solidtex" analyze "$demo/spots.png" -o "$demo/spots.stx"
-"$build/bin/solidtex" slice "$demo/spots.stx" --axis z --at 0 --size 96,96 -o "$demo/cut_z.png" --stats "$demo/cut_z.json"
-echo
-echo "demo ready in $demo:"
-echo "  table    $demo/spots.stx"
-echo "  a z-cut  $demo/cut_z.png (stats: $demo/cut_z.json)"
-echo "try:  $build/bin/solidtex slice $demo/spots.stx --plane 0,0,0,0.6,0.8,0,-0.48,0.36,0.8 --size 96,96 -o /tmp/oblique.png"
+port=${2:-8080}
+host=127.0.0.1
+data=${SOLIDTEX_DEMO_DATA:-$build/demo-data}
+demo=$build/demo
+url="http://$host:$port"
+mkdir -p "$demo" "$data"
+
+"$build/bin/solidtex" serve --host "$host" --port "$port" --data "$data" &
+server=$!
+trap 'kill -TERM $server 2>/dev/null || true; wait $server 2>/dev/null || true' EXIT INT TERM
+for _ in $(seq 1 100); do
+  curl -sf "$url/healthz" >/dev/null && break
+  kill -0 $server 2>/dev/null || { echo "solidtex serve did not start" >&2; exit 1; }
+  sleep 0.1
+done
+
+json() { python3 -c "import json,sys; d=json.load(sys.stdin); print($1)"; }
+volume=$(curl -sf "$url/v1/volumes" | json "next((v['id'] for v in d['volumes'] if v['name']=='demo-wood'), '')")
+if [ -z "$volume" ]; then
+  echo "creating the demo: a procedural wood exemplar, analysed, textured along a rotated grain"
+  "$build/bin/solidtex" exemplar wood --size 96,96 -o "$demo/wood.png" >/dev/null
+  job=$(curl -sf -X POST --data-binary @"$demo/wood.png" -H 'Content-Type: image/png' \
+        "$url/v1/exemplars?name=demo-wood&grain=x" | json "d['job']['id']")
+  for _ in $(seq 1 600); do
+    state=$(curl -sf "$url/v1/jobs/$job" | json "d['state']")
+    [ "$state" = succeeded ] && break
+    [ "$state" = failed ] && { echo "demo analysis failed" >&2; exit 1; }
+    sleep 0.5
+  done
+  exemplar=$(curl -sf "$url/v1/jobs/$job" | json "d['exemplar_id']")
+  volume=$(curl -sf -X POST -H 'Content-Type: application/json' \
+           -d "{\"name\": \"demo-wood\", \"exemplar\": \"$exemplar\", \"field\": {\"spec\": \"axis:0,0,1,30\"}, \"seed\": 1}" \
+           "$url/v1/volumes" | json "d['id']")
+fi
+# Warm the cache with the first cut suggested below, so that it answers at once (a new cut
+# costs tens of seconds on 2 cores; repeats and overlapping cuts reuse the cached voxels).
+cut="$url/v1/volumes/$volume/slice?axis=z&at=0&size=96,96"
+if ! curl -sf -o "$demo/cut_z.png" "$cut&timeout=300"; then echo "warning: the warm-up cut failed" >&2; fi
+
+cat <<MSG
+
+solidtex is serving on $url (data in $data); demo volume: $volume
+try:
+  curl -o cut.png  "$cut"                      (cached: instant)
+  curl -o side.png "$url/v1/volumes/$volume/slice?axis=y&at=5&size=96,48"
+  curl -o box.vdb  "$url/v1/volumes/$volume/region?min=0,0,0&size=24,24,24"
+  curl "$url/v1/volumes/$volume/stats"
+  curl "$url/metrics"
+  API contract: $url/v1/openapi.json
+Ctrl-C stops the server.
+MSG
+wait $server
