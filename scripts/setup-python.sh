@@ -7,7 +7,8 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 build=${1:-$root/build}
 venv="$build/venv"
 if [ ! -x "$venv/bin/python" ]; then
-  python3 -m venv --system-site-packages "$venv"
+  # Debian's interpreter: its site-packages hold the Debian python3-* packages.
+  /usr/bin/python3 -m venv --system-site-packages "$venv"
 fi
 if ! "$venv/bin/python" -c "import solidtex_client" 2>/dev/null; then
   "$venv/bin/python" -m pip install --quiet --no-deps --no-build-isolation --no-index -e "$root/client"

@@ -94,9 +94,10 @@ class Server:
 
     def log(self, tail: int = 4000) -> str:
         try:
-            self._log.flush()
+            if not self._log.closed:
+                self._log.flush()
             return self.log_path.read_bytes()[-tail:].decode("utf-8", "replace")
-        except OSError:
+        except (OSError, ValueError):
             return ""
 
     @property

@@ -104,8 +104,11 @@ def test_wrong_method_is_405(err):
              ("GET", f"/v1/volumes/{err.volume_id}/cut"), ("POST", "/healthz"),
              ("PUT", f"/v1/volumes/{err.volume_id}")]
     for method, path in cases:
-        assert_error(requests.request(method, err.url + path, timeout=30), 405,
-                     "method_not_allowed")
+        r = requests.request(method, err.url + path, timeout=30)
+        assert_error(r, 405, "method_not_allowed")
+        assert r.headers.get("Allow"), f"405 without Allow header for {method} {path}"
+    assert requests.put(err.url + "/v1/volumes", timeout=30).headers["Allow"].replace(" ", "") \
+        in ("GET,POST", "POST,GET")
 
 
 def test_undecodable_images_are_rejected_at_once(err, exemplars):

@@ -64,7 +64,6 @@ def test_field_lifecycle_and_volume_matches_cli(shared, tmp_path):
     stf_path.write_bytes(stf)
 
     vol = c.create_volume(exemplar=shared.exemplar_id, field={"id": fid}, seed=7)
-    assert fid in vol.get("field", fid)
     png = c.slice(vol["id"], "z", 16, (32, 24), dtype="png_bytes")
     out = tmp_path / "cli.png"
     run_cli("slice", shared.table_path, "--axis", "z", "--at", "16", "--size", "32,24",
@@ -78,6 +77,10 @@ def test_field_lifecycle_and_volume_matches_cli(shared, tmp_path):
     assert_error(requests.get(f"{url}/v1/fields/{fid}", timeout=60), 404, "not_found")
     vol_png = c.slice(vol["id"], "z", 16, (32, 24), dtype="png_bytes")
     assert np.array_equal(png_pixels(vol_png), png_pixels(png))
+
+    # contract: Volume.field names where the field came from (the stored field and revision)
+    assert vol["field"] == {"kind": "stored", "id": fid, "revision": 2}, vol
+    assert isinstance(vol["field_description"], str) and vol["field_description"], vol
 
 
 def test_malformed_sketches(shared):

@@ -92,3 +92,24 @@ def test_deadline_answers_504_and_cancels(busy):
     r = small_slice_eventually(busy.url, busy.volume_id)
     assert r.status_code == 200, r.text
     assert time.monotonic() - t0 < 15
+
+
+def test_too_many_analysis_jobs_is_429(server, exemplars):
+    srv = server("--max-jobs", "1")
+    data = exemplars["noise"].read_bytes()
+    params = {"levels": 3, "neighborhood": 7, "candidates": 8, "pca_dims": 12}
+    first = requests.post(srv.url + "/v1/exemplars", params=params, data=data,
+                          headers={"Content-Type": "application/octet-stream"}, timeout=60)
+    assert first.status_code == 202, first.text
+    second = requests.post(srv.url + "/v1/exemplars", params=params, data=data,
+                           headers={"Content-Type": "application/octet-stream"}, timeout=60)
+    assert_error(second, 429)
+    from solidtex_client import TooManyRequests
+    with pytest.raises(TooManyRequests):
+        srv.client.upload_exemplar(data, **params)
+    srv.client.wait_for_job(first.json()["job"]["id"], timeout=120, poll=0.1)
+    # the refused uploads left nothing behind, and a new one is accepted now
+    assert [e["id"] for e in srv.client.list_exemplars()] == [first.json()["exemplar"]["id"]]
+    third = requests.post(srv.url + "/v1/exemplars", params=params, data=data,
+                          headers={"Content-Type": "application/octet-stream"}, timeout=60)
+    assert third.status_code == 202, third.text
