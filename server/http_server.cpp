@@ -125,6 +125,9 @@ class Server {
                         // connection) is four times larger so that most oversized bodies get the 413.
                         .incoming_http_msg_limits(restinio::incoming_http_msg_limits_t{}.max_body_size(
                             std::uint64_t(config_.max_upload_bytes) * 4))
+                        // Keep reading while a request is in progress, so that a client hanging up
+                        // is noticed (connection_state_listener) and its work cancelled.
+                        .max_pipelined_requests(4)
                         // Deadlines are ours (504); RESTinio's timeout only catches stuck requests.
                         .handle_request_timeout(std::chrono::seconds(int64_t(config_.max_deadline_s) + 120))
                         .read_next_http_message_timelimit(std::chrono::seconds(120))
