@@ -249,20 +249,22 @@ class Client:
 
     def upload_exemplar(self, image: ImageInput, yz: Optional[ImageInput] = None,
                         zx: Optional[ImageInput] = None, mask: Optional[ImageInput] = None,
+                        mask_yz: Optional[ImageInput] = None, mask_zx: Optional[ImageInput] = None,
                         **analysis_params: Any) -> Dict[str, Any]:
         """POST /v1/exemplars: upload an exemplar; its analysis runs in the background.
 
         ``image`` (and ``yz``, ``zx``, ``mask``) is a path, encoded bytes, a PIL image or a
         numpy array (arrays are sent as PNG, see :func:`encode_png`). One image alone is
         sent as the raw body (``application/octet-stream``); with ``yz``/``zx``/``mask`` the
-        body is multipart/form-data with parts ``xy``, ``yz``, ``zx``, ``mask``.
+        body is multipart/form-data with parts ``xy``, ``yz``, ``zx``, ``mask``, ``mask_yz``,
+        ``mask_zx`` (feature masks of the three planes).
         ``analysis_params`` go in the query: ``name``, ``levels``, ``neighborhood`` (odd
         template size in pixels), ``candidates``, ``pca_dims``, ``seed``, ``plane_weights``
-        (a 3-sequence or ``"a,b,c"``). Returns ``{"exemplar": ..., "job": ...}``.
+        (a 3-sequence or ``"a,b,c"``), ``grain`` (``"x"``), ``mask_weight``. Returns ``{"exemplar": ..., "job": ...}``.
         """
         params = {k: v for k, v in analysis_params.items() if v is not None}
         xy = image_bytes(image)
-        extra = {"yz": yz, "zx": zx, "mask": mask}
+        extra = {"yz": yz, "zx": zx, "mask": mask, "mask_yz": mask_yz, "mask_zx": mask_zx}
         if all(v is None for v in extra.values()):
             r = self.request("POST", "/v1/exemplars", params=params, data=xy,
                              headers={"Content-Type": "application/octet-stream"})
