@@ -104,7 +104,7 @@ Result<Sketch> parse_sketch_json(const std::string& text) {
   } catch (const std::exception& e) {
     return bad("sketch", std::string("is not valid JSON: ") + e.what());
   }
-  SOLIDTEX_RETURN_IF_ERROR(check_keys(j, {"domain", "curves", "scales"}, "sketch"));
+  SOLIDTEX_RETURN_IF_ERROR(check_keys(j, {"domain", "curves", "scales", "frames"}, "sketch"));
   Sketch s;
   if (!j.contains("domain")) return bad("domain", "is required");
   SOLIDTEX_RETURN_IF_ERROR(check_keys(j["domain"], {"min", "max", "shortest_side_cells"}, "domain"));
@@ -119,9 +119,42 @@ Result<Sketch> parse_sketch_json(const std::string& text) {
       return bad("domain.shortest_side_cells", "must be an integer in [2, 256]");
     s.domain.shortest_side_cells = c.get<int>();
   }
-  if (!j.contains("curves") || !j["curves"].is_array()) return bad("curves", "is required (an array)");
-  if (j["curves"].empty()) return bad("curves", "needs at least one curve");
-  for (size_t i = 0; i < j["curves"].size(); ++i) {
+  const SketchDomain& dom = s.domain;
+  auto inside = [&](const WorldPoint& p) {
+    return p.x >= dom.min.x && p.y >= dom.min.y && p.z >= dom.min.z && p.x <= dom.max.x && p.y <= dom.max.y && p.z <= dom.max.z;
+  };
+  if (j.contains("frames")) {
+    if (!j["frames"].is_array()) return bad("frames", "must be an array");
+    for (size_t i = 0; i < j["frames"].size(); ++i) {
+      const std::string where = "frames[" + std::to_string(i) + "]";
+      const json& e = j["frames"][i];
+      SOLIDTEX_RETURN_IF_ERROR(check_keys(e, {"point", "quaternion", "weight"}, where));
+      if (!e.contains("point") || !e.contains("quaternion")) return bad(where, "needs \"point\" and \"quaternion\"");
+      SketchFrame f;
+      SOLIDTEX_ASSIGN_OR_RETURN(f.point, point(e["point"], where + ".point"));
+      if (!inside(f.point)) return bad(where + ".point", "lies outside the domain");
+      const json& q = e["quaternion"];
+      if (!q.is_array() || q.size() != 4) return bad(where + ".quaternion", "must be [w, x, y, z]");
+      double v[4];
+      for (size_t k = 0; k < 4; ++k) {
+        if (!q[k].is_number() || !std::isfinite(q[k].get<double>())) return bad(where + ".quaternion", "must be 4 finite numbers");
+        v[k] = q[k].get<double>();
+      }
+      f.frame = {v[0], v[1], v[2], v[3]};
+      if (!(std::sqrt(f.frame.dot(f.frame)) > 1e-9)) return bad(where + ".quaternion", "must be non-zero");
+      f.frame = f.frame.normalized();
+      if (e.contains("weight")) {
+        if (!e["weight"].is_number() || !(e["weight"].get<double>() > 0 && e["weight"].get<double>() <= 1e6))
+          return bad(where + ".weight", "must be in (0, 1e6]");
+        f.weight = e["weight"].get<double>();
+      }
+      s.frames.push_back(f);
+    }
+  }
+  if (j.contains("curves") && !j["curves"].is_array()) return bad("curves", "must be an array");
+  if (!j.contains("curves") && s.frames.empty()) return bad("curves", "is required (an array)");
+  if (j.contains("curves") && j["curves"].empty() && s.frames.empty()) return bad("curves", "needs at least one curve");
+  for (size_t i = 0; j.contains("curves") && i < j["curves"].size(); ++i) {
     SOLIDTEX_ASSIGN_OR_RETURN(auto c, curve_from_json(j["curves"][i], int(i)));
     SOLIDTEX_RETURN_IF_ERROR(validate_curve(c, s.domain, int(i)));
     s.curves.push_back(std::move(c));
@@ -139,10 +172,7 @@ Result<Sketch> parse_sketch_json(const std::string& text) {
       sp.scale = {sc.x, sc.y, sc.z};
       for (double v : sp.scale)
         if (!(v >= 0.25 && v <= 4.0)) return bad(where + ".scale", "each factor must be in [0.25, 4]");
-      const WorldPoint& p = sp.point;
-      const SketchDomain& d = s.domain;
-      if (p.x < d.min.x || p.y < d.min.y || p.z < d.min.z || p.x > d.max.x || p.y > d.max.y || p.z > d.max.z)
-        return bad(where + ".point", "lies outside the domain");
+      if (!inside(sp.point)) return bad(where + ".point", "lies outside the domain");
       if (e.contains("weight")) {
         if (!e["weight"].is_number() || !(e["weight"].get<double>() > 0 && e["weight"].get<double>() <= 1e6))
           return bad(where + ".weight", "must be in (0, 1e6]");
@@ -152,6 +182,41 @@ Result<Sketch> parse_sketch_json(const std::string& text) {
     }
   }
   return s;
+}
+
+std::string sketch_to_json(const Sketch& s) {
+  auto p3 = [](const WorldPoint& p) { return json::array({p.x, p.y, p.z}); };
+  json j;
+  j["domain"] = {{"min", p3(s.domain.min)}, {"max", p3(s.domain.max)}, {"shortest_side_cells", s.domain.shortest_side_cells}};
+  if (!s.frames.empty()) {
+    json frames = json::array();
+    for (const auto& f : s.frames)
+      frames.push_back({{"point", p3(f.point)}, {"quaternion", {f.frame.w, f.frame.x, f.frame.y, f.frame.z}}, {"weight", f.weight}});
+    j["frames"] = frames;
+  }
+  json curves = json::array();
+  for (const auto& c : s.curves) {
+    json cj;
+    cj["points"] = json::array();
+    for (const auto& p : c.points) cj["points"].push_back(p3(p));
+    if (!c.normals.empty()) {
+      cj["normals"] = json::array();
+      for (const auto& n : c.normals) cj["normals"].push_back(p3(n));
+    } else if (c.plane_normal) {
+      cj["plane_normal"] = p3(*c.plane_normal);
+    }
+    if (c.axis) cj["axis"] = std::string(1, char('x' + *c.axis));
+    cj["weight"] = c.weight;
+    curves.push_back(cj);
+  }
+  j["curves"] = curves;
+  if (!s.scales.empty()) {
+    json scales = json::array();
+    for (const auto& sp : s.scales)
+      scales.push_back({{"point", p3(sp.point)}, {"scale", {sp.scale[0], sp.scale[1], sp.scale[2]}}, {"weight", sp.weight}});
+    j["scales"] = scales;
+  }
+  return j.dump();
 }
 
 }  // namespace solidtex

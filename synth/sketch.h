@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "status.h"
+#include "frame_field.h"
 #include "types.h"
 
 namespace solidtex {
@@ -35,13 +36,25 @@ struct ScalePoint {
   double weight = 100.0;
 };
 
+// An explicit frame at a point (e.g. principal-curvature frames of a mesh): a soft constraint
+// like a curve sample. The quaternion's sign is taken as given (the producer keeps
+// neighbouring frames' signs consistent), so the set is solved in one go.
+struct SketchFrame {
+  WorldPoint point;
+  Quat frame;            // unit after parsing
+  double weight = 100.0;  // (0, 1e6]
+};
+
 struct Sketch {
   SketchDomain domain;
-  std::vector<SketchCurve> curves;
+  std::vector<SketchFrame> frames;  // optional; solved first, in one batch
+  std::vector<SketchCurve> curves;  // at least one curve or one frame
   std::vector<ScalePoint> scales;  // optional
 };
 
 Result<Sketch> parse_sketch_json(const std::string& text);
+// The JSON form parse_sketch_json reads back (numbers printed to round-trip doubles).
+std::string sketch_to_json(const Sketch& sketch);
 // One curve object as found in "curves" (also the body of "add a curve" requests).
 Result<SketchCurve> parse_curve_json(const std::string& text, int index);
 Status validate_curve(const SketchCurve& c, const SketchDomain& d, int index);

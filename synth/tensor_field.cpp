@@ -152,6 +152,25 @@ struct FieldSolver::Impl {
   }
   Quat current_at(const Vec3& p) const { return field_at(p); }
 
+  // Soft constraint on the interpolated value at p: w2 ||sum_c b_c q_c - qbar||^2.
+  void constrain(const Vec3& p, const Quat& q, double w2) {
+    std::array<int, 8> idx;
+    std::array<double, 8> b;
+    corners(p, idx, b);
+    for (int c = 0; c < 8; ++c) {
+      if (b[size_t(c)] == 0) continue;
+      auto& r = rhs[size_t(idx[size_t(c)])];
+      const double wb = w2 * b[size_t(c)];
+      r[0] += wb * q.w;
+      r[1] += wb * q.x;
+      r[2] += wb * q.y;
+      r[3] += wb * q.z;
+      weight[size_t(idx[size_t(c)])] += wb;
+      for (int e = 0; e < 8; ++e)
+        if (b[size_t(e)] != 0) constraint.emplace_back(idx[size_t(c)], idx[size_t(e)], wb * b[size_t(e)]);
+    }
+  }
+
   Status solve(FieldSolveStats* stats) {
     const auto t0 = std::chrono::steady_clock::now();
     Eigen::SparseMatrix<double> c(n, n);
@@ -341,23 +360,22 @@ Status FieldSolver::add_curve(const SketchCurve& c, int index, FieldSolveStats* 
       }
       previous = q;
       have_previous = true;
-      // Soft constraint on the interpolated value: w^2 ||sum_c b_c q_c - qbar||^2.
-      std::array<int, 8> idx;
-      std::array<double, 8> b;
-      m.corners(p, idx, b);
-      for (int c = 0; c < 8; ++c) {
-        if (b[size_t(c)] == 0) continue;
-        auto& r = m.rhs[size_t(idx[size_t(c)])];
-        const double wb = w2 * b[size_t(c)];
-        r[0] += wb * q.w;
-        r[1] += wb * q.x;
-        r[2] += wb * q.y;
-        r[3] += wb * q.z;
-        m.weight[size_t(idx[size_t(c)])] += wb;
-        for (int e = 0; e < 8; ++e)
-          if (b[size_t(e)] != 0) m.constraint.emplace_back(idx[size_t(c)], idx[size_t(e)], wb * b[size_t(e)]);
-      }
+      m.constrain(p, q, w2);
     }
+  }
+  ++m.curves;
+  return m.solve(stats);
+}
+
+Status FieldSolver::add_frames(const std::vector<SketchFrame>& frames, FieldSolveStats* stats) {
+  Impl& m = *impl_;
+  if (frames.empty()) return Status::ok();
+  const bool first = m.curves == 0;
+  for (const SketchFrame& f : frames) {
+    const Vec3 p = v3(f.point);
+    Quat q = f.frame.normalized();
+    if (!first && q.dot(m.current_at(p)) < 0) q = negate(q);
+    m.constrain(p, q, f.weight * f.weight);
   }
   ++m.curves;
   return m.solve(stats);
@@ -366,6 +384,7 @@ Status FieldSolver::add_curve(const SketchCurve& c, int index, FieldSolveStats* 
 Result<std::unique_ptr<FieldSolver>> FieldSolver::solve(const Sketch& sketch, FieldSolveStats* stats) {
   SOLIDTEX_ASSIGN_OR_RETURN(auto solver, create(sketch.domain));
   const auto t0 = std::chrono::steady_clock::now();
+  SOLIDTEX_RETURN_IF_ERROR(solver->add_frames(sketch.frames, stats));
   for (size_t i = 0; i < sketch.curves.size(); ++i) SOLIDTEX_RETURN_IF_ERROR(solver->add_curve(sketch.curves[i], int(i), stats));
   SOLIDTEX_RETURN_IF_ERROR(solver->set_scales(sketch.scales));
   if (stats) stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

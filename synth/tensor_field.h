@@ -44,6 +44,9 @@ class FieldSolver {
 
   // Adds a validated curve and re-solves. `index` is only used in error messages.
   Status add_curve(const SketchCurve& curve, int index, FieldSolveStats* stats = nullptr);
+  // Adds explicit frames (signs as given) in one batch and re-solves once; a first batch
+  // counts as the field's first "curve" (later unlabelled curves align to it).
+  Status add_frames(const std::vector<SketchFrame>& frames, FieldSolveStats* stats = nullptr);
   // Sets the sparse scale points (replacing earlier ones) and solves the log-scale field.
   Status set_scales(const std::vector<ScalePoint>& scales);
   // Solves a whole sketch: every curve in order, then the scales.
