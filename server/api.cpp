@@ -4,6 +4,7 @@
 
 #include "http_errors.h"
 #include "image_io.h"
+#include "api_json.h"
 #include "json_fields.h"
 #include "openapi_document.h"
 #include "query_params.h"
@@ -126,8 +127,8 @@ Status no_query(const HttpRequest& r) { return QueryParams::parse(r.query, {}).s
 }  // namespace
 
 Api::Api(const ServerConfig& config, ExemplarService& exemplars, FieldService& fields, VolumeService& volumes,
-         Metrics& metrics, const WorkerPool& pool, const std::atomic<bool>& shutting_down)
-    : config_(config), exemplars_(exemplars), fields_(fields), volumes_(volumes), metrics_(metrics), pool_(pool),
+         MeshService& meshes, Metrics& metrics, const WorkerPool& pool, const std::atomic<bool>& shutting_down)
+    : config_(config), exemplars_(exemplars), fields_(fields), volumes_(volumes), meshes_(meshes), metrics_(metrics), pool_(pool),
       shutting_down_(shutting_down) {}
 
 Result<std::unique_ptr<RequestInterrupter>> Api::interrupter_for(const HttpRequest& r, const std::string& timeout) const {
@@ -430,5 +431,161 @@ HttpResponse Api::points(const HttpRequest& r) {
 }
 
 HttpResponse Api::volume_stats(const HttpRequest& r) { return respond(200, [&] { return volumes_.stats(r.param("id")); }); }
+
+HttpResponse Api::list_meshes(const HttpRequest& r) {
+  if (Status s = no_query(r); !s.is_ok()) return HttpResponse::error(s);
+  return HttpResponse::json(200, meshes_.list());
+}
+
+HttpResponse Api::upload_mesh(const HttpRequest& r) {
+  auto result = [&]() -> Result<HttpResponse> {
+    SOLIDTEX_ASSIGN_OR_RETURN(QueryParams q, QueryParams::parse(r.query, {"name"}));
+    const std::string name = q.get("name").value_or("");
+    if (name.size() > 200) return Status(StatusCode::kInvalidArgument, "is longer than 200 characters", "name");
+    if (r.content_type == "application/json" || r.multipart)
+      return Status(StatusCode::kUnsupported, "send the mesh file's bytes (OBJ, PLY or OFF)", "Content-Type");
+    SOLIDTEX_ASSIGN_OR_RETURN(json created, meshes_.upload(std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(r.body.data()), r.body.size()), name));
+    HttpResponse out = HttpResponse::json(201, created);
+    out.headers.push_back({"Location", "/v1/meshes/" + created["id"].get<std::string>()});
+    return out;
+  }();
+  return result ? *result : HttpResponse::error(result.status());
+}
+
+HttpResponse Api::get_mesh(const HttpRequest& r) { return respond(200, [&] { return meshes_.get(r.param("id")); }); }
+
+HttpResponse Api::delete_mesh(const HttpRequest& r) { return respond_status(meshes_.remove(r.param("id"))); }
+
+HttpResponse Api::get_mesh_file(const HttpRequest& r) {
+  auto mesh = meshes_.mesh(r.param("id"));
+  if (!mesh) return HttpResponse::error(Status(mesh.status().code(), mesh.status().message(), "id"));
+  return respond_bytes(encode_ply(**mesh));
+}
+
+HttpResponse Api::surface(const HttpRequest& r) {
+  auto result = [&]() -> Result<HttpResponse> {
+    std::shared_ptr<const Mesh> mesh;
+    Placement placement;
+    std::string format = "ply";
+    std::vector<std::array<double, 3>> extra;
+    std::string timeout;
+    if (r.content_type == "application/json") {
+      SOLIDTEX_ASSIGN_OR_RETURN(QueryParams q, QueryParams::parse(r.query, {"timeout"}));
+      timeout = q.get("timeout").value_or("");
+      SOLIDTEX_ASSIGN_OR_RETURN(json j, parse_json_text(r.body, "body"));
+      SOLIDTEX_RETURN_IF_ERROR(check_keys(j, {"mesh", "placement", "format", "points"}, ""));
+      if (!j.contains("mesh")) return Status(StatusCode::kInvalidArgument, "is required", "mesh");
+      SOLIDTEX_ASSIGN_OR_RETURN(std::string mesh_id, json_string(j["mesh"], "mesh", 64));
+      SOLIDTEX_ASSIGN_OR_RETURN(mesh, meshes_.mesh(mesh_id));
+      SOLIDTEX_ASSIGN_OR_RETURN(placement, placement_from_json(j.value("placement", json::object()), "placement", mesh->bounds(), nullptr));
+      if (j.contains("format")) { SOLIDTEX_ASSIGN_OR_RETURN(format, json_string(j["format"], "format")); }
+      if (j.contains("points")) {
+        if (!j["points"].is_array()) return Status(StatusCode::kInvalidArgument, "must be an array of [x,y,z]", "points");
+        for (size_t i = 0; i < j["points"].size(); ++i) {
+          SOLIDTEX_ASSIGN_OR_RETURN(WorldPoint p, json_point(j["points"][i], "points[" + std::to_string(i) + "]"));
+          extra.push_back({p.x, p.y, p.z});
+        }
+      }
+    } else {
+      if (r.multipart) return Status(StatusCode::kUnsupported, "send the mesh bytes or a JSON request", "Content-Type");
+      SOLIDTEX_ASSIGN_OR_RETURN(QueryParams q, QueryParams::parse(r.query, {"timeout", "resolution", "margin", "format"}));
+      timeout = q.get("timeout").value_or("");
+      format = q.get("format").value_or("ply");
+      SOLIDTEX_ASSIGN_OR_RETURN(int64_t resolution, q.get_int("resolution", 512, 8, 4096));
+      SOLIDTEX_ASSIGN_OR_RETURN(double margin, q.get_double("margin", 0.25, 0, 1));
+      SOLIDTEX_ASSIGN_OR_RETURN(Mesh decoded, meshes_.decode(std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(r.body.data()), r.body.size())));
+      mesh = std::make_shared<const Mesh>(std::move(decoded));
+      SOLIDTEX_ASSIGN_OR_RETURN(placement, fit_placement(mesh->bounds(), int(resolution), margin));
+    }
+    if (format != "ply" && format != "json") return Status(StatusCode::kInvalidArgument, "must be ply or json", "format");
+    if (format == "ply" && !extra.empty()) return Status(StatusCode::kInvalidArgument, "extra points need format json", "points");
+    const size_t nv = mesh->vertices.size();
+    SOLIDTEX_RETURN_IF_ERROR(volumes_.check_target_size(int64_t(nv + extra.size()), "mesh"));
+    std::vector<WorldPoint> world;
+    world.reserve(nv + extra.size());
+    for (const auto& v : mesh->vertices) world.push_back(placement.apply(v));
+    for (const auto& p : extra) world.push_back(placement.apply(p));
+    SOLIDTEX_ASSIGN_OR_RETURN(TargetSet target, TargetSet::points(world));
+    SOLIDTEX_ASSIGN_OR_RETURN(auto interrupter, interrupter_for(r, timeout));
+    auto qr = volumes_.query(r.param("id"), "surface", target, *interrupter);
+    if (!qr && qr.status().code() == StatusCode::kCancelled) return interrupter->interruption_status("the surface");
+    if (!qr) return qr.status();
+    const int64_t bounding = bounding_voxels(mesh->bounds(), placement);
+    HttpResponse out;
+    if (format == "ply") {
+      ImageF img(int(nv), 1, 3);
+      for (size_t i = 0; i < nv; ++i)
+        for (int c = 0; c < 3; ++c) img.pixels[i * 3 + size_t(c)] = qr->rgb[i][size_t(c)];
+      const std::vector<uint8_t> srgb = to_srgb8(img);
+      const std::vector<uint8_t> ply = encode_ply(*mesh, &srgb);
+      out.content_type = "application/x-ply";
+      out.body.assign(ply.begin(), ply.end());
+    } else {
+      json colors = json::array(), point_colors = json::array();
+      for (size_t i = 0; i < qr->rgb.size(); ++i)
+        (i < nv ? colors : point_colors).push_back({qr->rgb[i][0], qr->rgb[i][1], qr->rgb[i][2]});
+      json stats = qr->stats;
+      stats["target_voxels"] = int64_t(target.voxels.size());
+      stats["bounding_voxels"] = bounding;
+      stats["voxels_synthesized"] = qr->voxels_synthesized;
+      stats["fraction"] = bounding > 0 ? double(qr->voxels_synthesized) / double(bounding) : 0.0;
+      out = HttpResponse::json(200, {{"vertices", int64_t(nv)},
+                                     {"colors", colors},
+                                     {"point_colors", point_colors},
+                                     {"placement", {{"scale", placement.scale}, {"translate", placement.translate}}},
+                                     {"stats", stats}});
+    }
+    out.headers.push_back({"X-Target-Voxels", std::to_string(target.voxels.size())});
+    out.headers.push_back({"X-Bounding-Voxels", std::to_string(bounding)});
+    out.headers.push_back({"X-Voxels-Synthesized", std::to_string(qr->voxels_synthesized)});
+    return out;
+  }();
+  return result ? *result : HttpResponse::error(result.status());
+}
+
+HttpResponse Api::field_from_mesh(const HttpRequest& r) {
+  auto result = [&]() -> Result<HttpResponse> {
+    SOLIDTEX_ASSIGN_OR_RETURN(QueryParams q, QueryParams::parse(r.query, {"timeout"}));
+    SOLIDTEX_RETURN_IF_ERROR(require_json_body(r));
+    SOLIDTEX_ASSIGN_OR_RETURN(json j, parse_json_text(r.body, "body"));
+    SOLIDTEX_RETURN_IF_ERROR(check_keys(j, {"mesh", "kind", "placement", "shortest_side_cells", "max_constraints",
+                                            "feature_angle_degrees", "curves"}, ""));
+    for (const char* k : {"mesh", "kind"})
+      if (!j.contains(k)) return Status(StatusCode::kInvalidArgument, "is required", k);
+    SOLIDTEX_ASSIGN_OR_RETURN(std::string mesh_id, json_string(j["mesh"], "mesh", 64));
+    SOLIDTEX_ASSIGN_OR_RETURN(std::string kind, json_string(j["kind"], "kind"));
+    MeshFieldOptions o;
+    if (kind == "curvature") o.kind = MeshFieldOptions::Kind::kCurvature;
+    else if (kind == "features") o.kind = MeshFieldOptions::Kind::kFeatures;
+    else return Status(StatusCode::kInvalidArgument, "must be curvature or features", "kind");
+    SOLIDTEX_ASSIGN_OR_RETURN(auto mesh, meshes_.mesh(mesh_id));
+    SOLIDTEX_ASSIGN_OR_RETURN(o.placement, placement_from_json(j.value("placement", json::object()), "placement", mesh->bounds(), &o.margin));
+    if (j.contains("shortest_side_cells")) { SOLIDTEX_ASSIGN_OR_RETURN(o.shortest_side_cells, json_int(j["shortest_side_cells"], "shortest_side_cells", 2, 256)); }
+    if (j.contains("max_constraints")) { SOLIDTEX_ASSIGN_OR_RETURN(o.max_constraints, json_int(j["max_constraints"], "max_constraints", 1, 20000)); }
+    if (j.contains("feature_angle_degrees")) { SOLIDTEX_ASSIGN_OR_RETURN(o.feature_angle_degrees, json_number(j["feature_angle_degrees"], "feature_angle_degrees", 1, 179)); }
+    if (j.contains("curves")) {
+      if (!j["curves"].is_array()) return Status(StatusCode::kInvalidArgument, "must be an array of polylines", "curves");
+      for (size_t i = 0; i < j["curves"].size(); ++i) {
+        const json& c = j["curves"][i];
+        const std::string where = "curves[" + std::to_string(i) + "]";
+        if (!c.is_array()) return Status(StatusCode::kInvalidArgument, "must be an array of [x,y,z]", where);
+        std::vector<std::array<double, 3>> line;
+        for (size_t k = 0; k < c.size(); ++k) {
+          SOLIDTEX_ASSIGN_OR_RETURN(WorldPoint p, json_point(c[k], where + "[" + std::to_string(k) + "]"));
+          line.push_back({p.x, p.y, p.z});
+        }
+        o.curves.push_back(std::move(line));
+      }
+    }
+    SOLIDTEX_ASSIGN_OR_RETURN(auto interrupter, interrupter_for(r, q.get("timeout").value_or("")));
+    auto created = fields_.create_from_mesh(*mesh, o, *interrupter);
+    if (!created && created.status().code() == StatusCode::kCancelled) return interrupter->interruption_status("the field solve");
+    if (!created) return created.status();
+    HttpResponse out = HttpResponse::json(201, *created);
+    out.headers.push_back({"Location", "/v1/fields/" + (*created)["id"].get<std::string>()});
+    return out;
+  }();
+  return result ? *result : HttpResponse::error(result.status());
+}
 
 }  // namespace solidtex::server

@@ -12,6 +12,7 @@
 #include "exemplar_service.h"
 #include "field_service.h"
 #include "http_types.h"
+#include "mesh_service.h"
 #include "metrics.h"
 #include "server_config.h"
 #include "volume_service.h"
@@ -22,7 +23,7 @@ namespace solidtex::server {
 class Api {
  public:
   Api(const ServerConfig& config, ExemplarService& exemplars, FieldService& fields, VolumeService& volumes,
-      Metrics& metrics, const WorkerPool& pool, const std::atomic<bool>& shutting_down);
+      MeshService& meshes, Metrics& metrics, const WorkerPool& pool, const std::atomic<bool>& shutting_down);
 
   HttpResponse healthz(const HttpRequest& r);
   HttpResponse metrics(const HttpRequest& r);
@@ -49,6 +50,13 @@ class Api {
   HttpResponse region(const HttpRequest& r);
   HttpResponse points(const HttpRequest& r);
   HttpResponse volume_stats(const HttpRequest& r);
+  HttpResponse list_meshes(const HttpRequest& r);
+  HttpResponse upload_mesh(const HttpRequest& r);
+  HttpResponse get_mesh(const HttpRequest& r);
+  HttpResponse delete_mesh(const HttpRequest& r);
+  HttpResponse get_mesh_file(const HttpRequest& r);
+  HttpResponse surface(const HttpRequest& r);
+  HttpResponse field_from_mesh(const HttpRequest& r);
 
  private:
   Result<std::unique_ptr<RequestInterrupter>> interrupter_for(const HttpRequest& r, const std::string& timeout) const;
@@ -59,6 +67,7 @@ class Api {
   ExemplarService& exemplars_;
   FieldService& fields_;
   VolumeService& volumes_;
+  MeshService& meshes_;
   Metrics& metrics_;
   const WorkerPool& pool_;
   const std::atomic<bool>& shutting_down_;

@@ -92,6 +92,28 @@ json to_json(const std::vector<LevelReport>& levels) {
   return out;
 }
 
+Result<Placement> placement_from_json(const json& j, const std::string& where, const MeshBounds& bounds, double* margin) {
+  SOLIDTEX_RETURN_IF_ERROR(check_keys(j, {"resolution", "margin", "scale", "translate"}, where));
+  double m = 0.25;
+  if (j.contains("margin")) { SOLIDTEX_ASSIGN_OR_RETURN(m, json_number(j["margin"], where + ".margin", 0, 1)); }
+  if (margin) *margin = m;
+  if (j.contains("scale")) {
+    if (j.contains("resolution"))
+      return Status(StatusCode::kInvalidArgument, "give either scale/translate or resolution", where + ".resolution");
+    Placement p;
+    SOLIDTEX_ASSIGN_OR_RETURN(p.scale, json_number(j["scale"], where + ".scale", 1e-12, 1e12));
+    if (j.contains("translate")) {
+      SOLIDTEX_ASSIGN_OR_RETURN(WorldPoint t, json_point(j["translate"], where + ".translate"));
+      p.translate = {t.x, t.y, t.z};
+    }
+    return p;
+  }
+  if (j.contains("translate")) return Status(StatusCode::kInvalidArgument, "needs scale", where + ".translate");
+  int64_t resolution = 512;
+  if (j.contains("resolution")) { SOLIDTEX_ASSIGN_OR_RETURN(resolution, json_int(j["resolution"], where + ".resolution", 8, 4096)); }
+  return fit_placement(bounds, int(resolution), m);
+}
+
 json status_json(const Status& s) {
   if (s.is_ok()) return nullptr;
   return {{"code", status_code_name(s.code())}, {"message", s.message()}, {"field", s.field()}};

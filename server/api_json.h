@@ -7,6 +7,7 @@
 
 #include "analysis.h"
 #include "analysis_params.h"
+#include "mesh.h"
 #include "synthesis_params.h"
 
 namespace solidtex::server {
@@ -18,6 +19,10 @@ nlohmann::json to_json(const SynthesisParams& p);
 Result<SynthesisParams> synthesis_params_from_json(const nlohmann::json& j, const std::string& where,
                                                    SynthesisParams base);
 nlohmann::json to_json(const std::vector<LevelReport>& levels);
-nlohmann::json status_json(const Status& s);  // null when ok, else {"code","message","field"}
+nlohmann::json status_json(const Status& s);
+// The Placement schema of proto/openapi.json: explicit {scale, translate} or a fit of the
+// enlarged bounding box to {resolution (512), margin (0.25)}. `margin` receives the margin.
+Result<Placement> placement_from_json(const nlohmann::json& j, const std::string& where, const MeshBounds& bounds,
+                                      double* margin);  // null when ok, else {"code","message","field"}
 
 }  // namespace solidtex::server

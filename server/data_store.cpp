@@ -18,11 +18,12 @@ const char* subdir(ResourceKind kind) {
     case ResourceKind::kExemplar: return "exemplars";
     case ResourceKind::kField: return "fields";
     case ResourceKind::kVolume: return "volumes";
+    case ResourceKind::kMesh: return "meshes";
   }
   return "unknown";
 }
 
-constexpr ResourceKind kKinds[] = {ResourceKind::kExemplar, ResourceKind::kField, ResourceKind::kVolume};
+constexpr ResourceKind kKinds[] = {ResourceKind::kExemplar, ResourceKind::kField, ResourceKind::kVolume, ResourceKind::kMesh};
 
 bool is_temporary(const std::string& name) { return name.find(".tmp-") != std::string::npos; }
 
@@ -33,6 +34,7 @@ const char* acknowledging_file(ResourceKind kind) {
     case ResourceKind::kExemplar: return "meta.json";
     case ResourceKind::kField: return "r1.json";
     case ResourceKind::kVolume: return "volume.json";
+    case ResourceKind::kMesh: return "meta.json";
   }
   return "";
 }

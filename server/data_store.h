@@ -4,6 +4,7 @@
 //   exemplars/<id>/table.stx    the analysis output, then result.json (reports or the error)
 //   fields/<id>/r<N>.stf, r<N>.json   revision N of a field (the .json last)
 //   volumes/<id>/field.stf      the volume's own copy of its field (optional), then volume.json
+//   meshes/<id>/source.mesh     the uploaded bytes, then meta.json
 // Every file is written atomically (temporary file, fsync, rename, fsync of the directory:
 // byte_io.h), and a resource's acknowledging file is written last, so a kill -9 at any moment
 // leaves either the whole resource or a leftover. open() removes leftovers and reports them:
@@ -23,7 +24,7 @@
 
 namespace solidtex::server {
 
-enum class ResourceKind { kExemplar, kField, kVolume };
+enum class ResourceKind { kExemplar, kField, kVolume, kMesh };
 
 class DataStore {
  public:

@@ -6,6 +6,7 @@
 
 #include "api_json.h"
 #include "json_fields.h"
+#include "mesh_geometry.h"
 #include "sketch.h"
 #include "tensor_field.h"
 
@@ -53,6 +54,7 @@ struct FieldService::Impl {
                         std::to_string(config.max_field_nodes) + " (lower shortest_side_cells or the domain's aspect)",
                     "domain.shortest_side_cells");
     const auto t0 = std::chrono::steady_clock::now();
+    SOLIDTEX_RETURN_IF_ERROR(solver->add_frames(sketch.frames, &stats));
     for (size_t i = 0; i < sketch.curves.size(); ++i) {
       if (interrupter.was_interrupted(int(100 * i / sketch.curves.size())))
         return Status(StatusCode::kCancelled, "field solve interrupted");
@@ -163,6 +165,49 @@ Result<json> FieldService::create(const std::string& sketch_text, Interrupter& i
   impl_->entries.emplace(id, std::move(e));
   impl_->trim_solvers();
   return *info;
+}
+
+Result<json> FieldService::create_from_mesh(const Mesh& mesh, const MeshFieldOptions& o, Interrupter& interrupter) {
+  if (o.shortest_side_cells < 2 || o.shortest_side_cells > 256)
+    return Status(StatusCode::kInvalidArgument, "must be in [2, 256]", "shortest_side_cells");
+  if (o.max_constraints < 1 || o.max_constraints > 20000)
+    return Status(StatusCode::kInvalidArgument, "must be in [1, 20000]", "max_constraints");
+  const MeshBounds box = placed_box(mesh.bounds(), o.placement, o.margin);
+  Sketch sketch;
+  sketch.domain.min = {box.min[0], box.min[1], box.min[2]};
+  sketch.domain.max = {box.max[0], box.max[1], box.max[2]};
+  sketch.domain.shortest_side_cells = o.shortest_side_cells;
+  const double spacing =
+      std::min({box.max[0] - box.min[0], box.max[1] - box.min[1], box.max[2] - box.min[2]}) / o.shortest_side_cells;
+  int dropped = 0;
+  if (o.kind == MeshFieldOptions::Kind::kCurvature) {
+    SOLIDTEX_ASSIGN_OR_RETURN(sketch.frames, curvature_frames(mesh, o.placement, o.max_constraints, spacing));
+  } else {
+    std::vector<SketchCurve> candidates;
+    auto crests = crest_curves(mesh, o.placement, o.feature_angle_degrees);
+    if (crests) candidates = std::move(*crests);
+    else if (o.curves.empty()) return crests.status();
+    SOLIDTEX_ASSIGN_OR_RETURN(auto user, surface_curves(mesh, o.placement, o.curves));
+    for (size_t i = 0; i < user.size(); ++i) {
+      SOLIDTEX_RETURN_IF_ERROR(validate_curve(user[i], sketch.domain, int(i)).with_context("user curve"));
+    }
+    candidates.insert(candidates.end(), user.begin(), user.end());
+    // Crest chains that define no frame somewhere (e.g. a tangent along a vertex normal at a
+    // cusp) are skipped, and counted.
+    for (auto& c : candidates) {
+      if (validate_curve(c, sketch.domain, int(sketch.curves.size())).is_ok()) sketch.curves.push_back(std::move(c));
+      else ++dropped;
+    }
+    if (sketch.curves.empty()) return Status(StatusCode::kUnprocessable, "no usable feature curve", "mesh");
+  }
+  const std::string text = sketch_to_json(sketch);
+  SOLIDTEX_ASSIGN_OR_RETURN(json info, create(text, interrupter));
+  info["from_mesh"] = {{"kind", o.kind == MeshFieldOptions::Kind::kCurvature ? "curvature" : "features"},
+                       {"frames", int64_t(sketch.frames.size())},
+                       {"curves", int64_t(sketch.curves.size())},
+                       {"dropped_curves", dropped},
+                       {"placement", {{"scale", o.placement.scale}, {"translate", o.placement.translate}}}};
+  return info;
 }
 
 Result<json> FieldService::add_curve(const std::string& id, const std::string& curve_text, Interrupter& interrupter) {

@@ -15,9 +15,24 @@
 #include "data_store.h"
 #include "field_file.h"
 #include "interrupter.h"
+#include "mesh.h"
 #include "server_config.h"
 
 namespace solidtex::server {
+
+// A field derived from a mesh's geometry (mesh_geometry.h): its domain is the placed mesh's
+// box enlarged by `margin`, and the constraints become an ordinary sketch (frames and/or
+// curves), stored and extendable like any other.
+struct MeshFieldOptions {
+  enum class Kind { kCurvature, kFeatures };
+  Kind kind = Kind::kCurvature;
+  Placement placement;
+  double margin = 0.25;
+  int shortest_side_cells = 24;   // [2, 256]
+  int max_constraints = 2000;     // curvature frames, [1, 20000]
+  double feature_angle_degrees = 60;
+  std::vector<std::vector<std::array<double, 3>>> curves;  // user polylines, mesh coordinates
+};
 
 class FieldService {
  public:
@@ -26,6 +41,7 @@ class FieldService {
 
   Status start(std::vector<std::string>* report);
   Result<nlohmann::json> create(const std::string& sketch_json, Interrupter& interrupter);
+  Result<nlohmann::json> create_from_mesh(const Mesh& mesh, const MeshFieldOptions& options, Interrupter& interrupter);
   Result<nlohmann::json> add_curve(const std::string& id, const std::string& curve_json, Interrupter& interrupter);
   Result<nlohmann::json> get(const std::string& id) const;
   nlohmann::json list() const;

@@ -102,11 +102,13 @@ class Server {
     exemplars_ = std::make_unique<ExemplarService>(*store_, config_);
     fields_ = std::make_unique<FieldService>(*store_, config_);
     volumes_ = std::make_unique<VolumeService>(*store_, config_, *exemplars_, *fields_);
+    meshes_ = std::make_unique<MeshService>(*store_, config_);
     pool_ = std::make_unique<WorkerPool>(config_.threads, config_.queue);
-    api_ = std::make_unique<Api>(config_, *exemplars_, *fields_, *volumes_, metrics_, *pool_, abort_running_);
+    api_ = std::make_unique<Api>(config_, *exemplars_, *fields_, *volumes_, *meshes_, metrics_, *pool_, abort_running_);
     SOLIDTEX_RETURN_IF_ERROR(fields_->start(&report));
     SOLIDTEX_RETURN_IF_ERROR(exemplars_->start(&report));
     SOLIDTEX_RETURN_IF_ERROR(volumes_->start(&report));
+    SOLIDTEX_RETURN_IF_ERROR(meshes_->start(&report));
     for (const std::string& line : report) std::cerr << "solidtex serve: " << line << "\n";
 
     // Signals go to the main thread only (sigwait below), never to I/O or worker threads.
@@ -289,6 +291,7 @@ class Server {
   std::unique_ptr<ExemplarService> exemplars_;
   std::unique_ptr<FieldService> fields_;
   std::unique_ptr<VolumeService> volumes_;
+  std::unique_ptr<MeshService> meshes_;
   std::unique_ptr<WorkerPool> pool_;
   std::unique_ptr<Api> api_;
   Metrics metrics_;

@@ -30,6 +30,13 @@ const std::vector<Route>& route_table() {
       {"GET", "/v1/volumes/{id}/region", E::kWorker, &Api::region},
       {"POST", "/v1/volumes/{id}/points", E::kWorker, &Api::points},
       {"GET", "/v1/volumes/{id}/stats", E::kInline, &Api::volume_stats},
+      {"GET", "/v1/meshes", E::kInline, &Api::list_meshes},
+      {"POST", "/v1/meshes", E::kWorker, &Api::upload_mesh},
+      {"GET", "/v1/meshes/{id}", E::kInline, &Api::get_mesh},
+      {"DELETE", "/v1/meshes/{id}", E::kWorker, &Api::delete_mesh},
+      {"GET", "/v1/meshes/{id}/file", E::kWorker, &Api::get_mesh_file},
+      {"POST", "/v1/volumes/{id}/surface", E::kWorker, &Api::surface},
+      {"POST", "/v1/fields/from-mesh", E::kWorker, &Api::field_from_mesh},
   };
   return routes;
 }

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "image_io.h"
+#include "mesh.h"
 #include "status.h"
 
 namespace solidtex::server {
@@ -24,6 +25,7 @@ struct ServerConfig {
   ImageLimits image_limits;         // side and pixel count, checked from the header: 422
   int64_t max_voxels = int64_t(1) << 22;          // target voxels (output samples) per request: 422
   int64_t max_field_nodes = int64_t(1) << 18;     // frame-field grid nodes per field: 422 beyond
+  MeshLimits mesh_limits;           // vertex and face counts per mesh: 422 beyond
   int max_jobs = 4;                 // analysis jobs queued or running, [1, 1000]; beyond: 429
   int analysis_threads = 1;         // analyses run at once, [1, 16]
 

@@ -343,7 +343,8 @@ Result<QueryResult> VolumeService::query(const std::string& id, const std::strin
       if (v->voxels_per_level.size() <= size_t(l.level)) v->voxels_per_level.resize(size_t(l.level) + 1, 0);
       v->voxels_per_level[size_t(l.level)] += l.voxels;
     }
-  v->recent.push_back(stats_json(kind, target, per_region, seconds));
+  out.stats = stats_json(kind, target, per_region, seconds);
+  v->recent.push_back(out.stats);
   if (v->recent.size() > kRecentRequests) v->recent.pop_front();
   return out;
 }

@@ -29,6 +29,7 @@ namespace solidtex::server {
 struct QueryResult {
   std::vector<std::array<float, 3>> rgb;  // linear RGB per target sample
   int64_t voxels_synthesized = 0;         // over all levels and regions (0: all cached)
+  nlohmann::json stats;                   // this request's entry in stats()' "recent"
 };
 
 class VolumeService {

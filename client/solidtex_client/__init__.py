@@ -6,8 +6,13 @@
 >>> c.wait_for_job(up["job"]["id"])
 >>> vol = c.create_volume(exemplar=up["exemplar"]["id"], seed=7)
 >>> rgb = c.slice(vol["id"], "z", 0, (64, 64))        # uint8 (64, 64, 3), sRGB
+>>> m = c.upload_mesh("bunny.off")
+>>> colored = c.surface(vol["id"], mesh_id=m["id"], placement={"resolution": 256})
+>>> from solidtex_client.render import render
+>>> img = render(colored, azimuth=30, elevation=20, size=(512, 512))
 """
 from .client import Client, encode_png, image_bytes
+from .mesh import ColoredMesh, PlyFormatError, mesh_bytes, parse_colored_ply
 from .errors import (BadRequest, Conflict, DeadlineExceeded, JobFailed, MethodNotAllowed,
                      NotFound, PayloadTooLarge, ServiceUnavailable, SolidtexError,
                      TooManyRequests, Unprocessable, UnsupportedMediaType,
@@ -15,6 +20,7 @@ from .errors import (BadRequest, Conflict, DeadlineExceeded, JobFailed, MethodNo
 
 __all__ = [
     "Client", "encode_png", "image_bytes",
+    "ColoredMesh", "PlyFormatError", "mesh_bytes", "parse_colored_ply",
     "SolidtexError", "BadRequest", "NotFound", "MethodNotAllowed", "Conflict",
     "PayloadTooLarge", "UnsupportedMediaType", "Unprocessable", "TooManyRequests",
     "ServiceUnavailable", "DeadlineExceeded", "JobFailed", "error_from_response",

@@ -6,6 +6,9 @@
     solidtex-client slice VOLUME --axis z --at K --size W,H [--origin U,V] -o OUT.png
     solidtex-client region VOLUME --min X,Y,Z --size W,H,D -o OUT.vdb|OUT.npy
     solidtex-client points VOLUME POINTS.npy|POINTS.txt -o OUT.npy|OUT.txt
+    solidtex-client mesh MESH.obj|.ply|.off [--name N]
+    solidtex-client render MESH --volume ID -o VIEW.png [--azimuth A --elevation E --size W,H
+                    --resolution R --margin M --no-light --up y|z --ply OUT.ply]
 
 JSON answers go to stdout. Errors print ``error: <code>: <message> (field)`` on stderr and
 exit with status 1. Coordinates and sizes are finest voxels, timeouts seconds.
@@ -112,6 +115,27 @@ def _parser() -> argparse.ArgumentParser:
     pt.add_argument("points", help=".npy (N x 3) or text, one 'x y z' (or x,y,z) per line")
     pt.add_argument("--timeout", type=float, help="server deadline, seconds")
     pt.add_argument("-o", "--output", required=True, help=".npy or .txt")
+
+    me = sub.add_parser("mesh", help="store a mesh (OBJ, PLY or OFF) and print its summary")
+    me.add_argument("mesh")
+    me.add_argument("--name")
+
+    rd = sub.add_parser("render", help="texture a mesh with a volume and render it to a PNG")
+    rd.add_argument("mesh", help="OBJ, PLY or OFF file (sent as is)")
+    rd.add_argument("--volume", required=True)
+    rd.add_argument("-o", "--output", required=True, help="PNG file")
+    rd.add_argument("--azimuth", type=float, default=30.0, help="degrees (default 30)")
+    rd.add_argument("--elevation", type=float, default=20.0, help="degrees (default 20)")
+    rd.add_argument("--size", type=_ints(2), default=[512, 512], metavar="W,H",
+                    help="image size in pixels (default 512,512)")
+    rd.add_argument("--resolution", type=int,
+                    help="voxels along the mesh's longest side (server default 512)")
+    rd.add_argument("--margin", type=float,
+                    help="fraction of the longest side added on every side (server default 0.25)")
+    rd.add_argument("--no-light", action="store_true", help="unshaded vertex colours")
+    rd.add_argument("--up", choices=["y", "z"], default="y", help="the mesh's up axis (default y)")
+    rd.add_argument("--ply", help="also write the coloured mesh to this PLY file")
+    rd.add_argument("--timeout", type=float, help="server deadline, seconds")
     return p
 
 
@@ -172,6 +196,39 @@ def _run(args: argparse.Namespace) -> None:
             np.savetxt(args.output, rgb, fmt="%.9g")
         else:
             np.save(args.output, rgb)
+    elif args.command == "mesh":
+        _print_json(client.upload_mesh(args.mesh, name=args.name))
+    elif args.command == "render":
+        _render(client, args)
+
+
+def _render(client: Client, args: argparse.Namespace) -> None:
+    from PIL import Image
+
+    from .render import render
+
+    if args.size[0] < 1 or args.size[1] < 1:
+        raise ValueError(f"--size must be positive, got {args.size}")
+    placement = {k: v for k, v in (("resolution", args.resolution), ("margin", args.margin))
+                 if v is not None}
+    colored = client.surface(args.volume, mesh=args.mesh, placement=placement, fmt="ply",
+                             timeout=args.timeout)
+    if args.ply:
+        with open(args.ply, "wb") as f:
+            f.write(colored.to_ply())
+    img = render(colored, azimuth=args.azimuth, elevation=args.elevation, size=args.size,
+                 light=not args.no_light, up=args.up)
+    Image.fromarray(img, "RGB").save(args.output, format="PNG")
+    summary = {"output": args.output, "vertices": len(colored.vertices),
+               "triangles": len(colored.faces)}
+    for key, header in (("target_voxels", "X-Target-Voxels"),
+                        ("bounding_voxels", "X-Bounding-Voxels"),
+                        ("voxels_synthesized", "X-Voxels-Synthesized")):
+        try:
+            summary[key] = colored.header_int(header)
+        except (KeyError, ValueError):
+            pass
+    _print_json(summary)
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:

@@ -19,6 +19,7 @@ import numpy as np
 import requests
 
 from .errors import JobFailed, error_from_response
+from .mesh import ColoredMesh, MeshInput, mesh_bytes, parse_colored_ply
 
 ImageInput = Union[str, "os.PathLike[str]", bytes, bytearray, memoryview, np.ndarray, Any]
 
@@ -361,6 +362,123 @@ class Client:
             if key in out:
                 out[key] = np.asarray(out[key], dtype=np.float64).reshape(-1, width)
         return out
+
+    def field_from_mesh(self, mesh_id: str, kind: str, *,
+                        placement: Optional[Mapping[str, Any]] = None,
+                        shortest_side_cells: Optional[int] = None,
+                        max_constraints: Optional[int] = None,
+                        feature_angle_degrees: Optional[float] = None,
+                        curves: Optional[Sequence[Sequence[Sequence[float]]]] = None,
+                        timeout: Optional[float] = None) -> Dict[str, Any]:
+        """POST /v1/fields/from-mesh: solve a frame field from a stored mesh's geometry.
+
+        ``kind``: ``"curvature"`` (principal-curvature frames at vertices, at most
+        ``max_constraints`` of them) or ``"features"`` (crest lines sharper than
+        ``feature_angle_degrees`` plus the user ``curves``, polylines in mesh coordinates).
+        ``placement`` as for :meth:`surface`; the field's domain is the placed mesh's box in
+        world units, so a volume using the field should texture the mesh with the same
+        placement. ``timeout`` is the server-side deadline in seconds. Returns the Field.
+        """
+        body: Dict[str, Any] = {"mesh": mesh_id, "kind": kind}
+        if placement is not None:
+            body["placement"] = dict(placement)
+        for key, value in (("shortest_side_cells", shortest_side_cells),
+                           ("max_constraints", max_constraints),
+                           ("feature_angle_degrees", feature_angle_degrees)):
+            if value is not None:
+                body[key] = value
+        if curves is not None:
+            body["curves"] = [np.asarray(c, dtype=np.float64).reshape(-1, 3).tolist()
+                              for c in curves]
+        return self.request("POST", "/v1/fields/from-mesh", json=body,
+                            params={"timeout": timeout},
+                            http_timeout=self._http_timeout(timeout)).json()
+
+    # -- meshes ---------------------------------------------------------------------------
+
+    def list_meshes(self) -> List[Dict[str, Any]]:
+        """GET /v1/meshes: the mesh objects."""
+        return self.request("GET", "/v1/meshes").json()["meshes"]
+
+    def upload_mesh(self, mesh: MeshInput, name: Optional[str] = None) -> Dict[str, Any]:
+        """POST /v1/meshes: store a mesh (OBJ, PLY ASCII/binary or OFF; the server detects
+        the format from the bytes). ``mesh`` is a path or the file's bytes; ``name`` defaults
+        to the file name for a path. Returns the Mesh (counts, bounds, defects)."""
+        if name is None and isinstance(mesh, (str, os.PathLike)):
+            name = os.path.basename(os.fspath(mesh))
+        r = self.request("POST", "/v1/meshes", params={"name": name}, data=mesh_bytes(mesh),
+                         headers={"Content-Type": "application/octet-stream"})
+        return r.json()
+
+    def get_mesh(self, mesh_id: str) -> Dict[str, Any]:
+        """GET /v1/meshes/{id}."""
+        return self.request("GET", f"/v1/meshes/{mesh_id}").json()
+
+    def delete_mesh(self, mesh_id: str) -> None:
+        """DELETE /v1/meshes/{id}."""
+        self.request("DELETE", f"/v1/meshes/{mesh_id}")
+
+    def get_mesh_file(self, mesh_id: str) -> bytes:
+        """GET /v1/meshes/{id}/file: binary PLY of the cleaned triangles (mesh coordinates)."""
+        return self.request("GET", f"/v1/meshes/{mesh_id}/file").content
+
+    def surface(self, volume_id: str, mesh_id: Optional[str] = None,
+                mesh: Optional[MeshInput] = None,
+                placement: Optional[Mapping[str, Any]] = None, fmt: str = "ply",
+                points: Any = None, timeout: Optional[float] = None) -> Any:
+        """POST /v1/volumes/{id}/surface: colour a mesh's vertices from the volume.
+
+        Name a stored mesh (``mesh_id``) or send one (``mesh``: a path or bytes). Each
+        vertex gets the colour of the finest voxel nearest its placed position
+        ``world = scale * mesh + translate``. ``placement``: ``{"resolution": R, "margin":
+        M}`` (fit the bounding box, enlarged by M of its longest side on every side, to R
+        voxels along the longest side, min corner at the origin; default 512 and 0.25) or
+        ``{"scale": s, "translate": [x, y, z]}`` (stored meshes only: a sent mesh takes
+        resolution and margin in the query).
+
+        ``fmt="ply"`` -> :class:`~solidtex_client.mesh.ColoredMesh` (sRGB8 colours; its
+        ``headers`` hold X-Target-Voxels, X-Bounding-Voxels, X-Voxels-Synthesized).
+        ``fmt="json"`` -> the answer dict with ``colors`` (and ``point_colors``, the colours of
+        the extra mesh-coordinate ``points``, stored meshes only) as linear float32 (N, 3)
+        arrays, ``placement`` and ``stats``. ``timeout`` is the server-side deadline, seconds.
+        """
+        if fmt not in ("ply", "json"):
+            raise ValueError("fmt must be 'ply' or 'json'")
+        if (mesh_id is None) == (mesh is None):
+            raise ValueError("give exactly one of mesh_id and mesh")
+        accept = "application/x-ply" if fmt == "ply" else "application/json"
+        http_timeout = self._http_timeout(timeout)
+        path = f"/v1/volumes/{volume_id}/surface"
+        if mesh_id is not None:
+            body: Dict[str, Any] = {"mesh": mesh_id, "format": fmt}
+            if placement is not None:
+                body["placement"] = dict(placement)
+            if points is not None:
+                body["points"] = np.asarray(points, dtype=np.float64).reshape(-1, 3).tolist()
+            r = self.request("POST", path, json=body, params={"timeout": timeout},
+                             headers={"Accept": accept}, http_timeout=http_timeout)
+        else:
+            if points is not None:
+                raise ValueError("points need a stored mesh (mesh_id)")
+            pl = dict(placement or {})
+            unknown = set(pl) - {"resolution", "margin"}
+            if unknown:
+                raise ValueError(f"a sent mesh takes only resolution and margin as placement, "
+                                 f"not {sorted(unknown)}; upload it to use scale/translate")
+            params = {"resolution": pl.get("resolution"), "margin": pl.get("margin"),
+                      "format": fmt, "timeout": timeout}
+            r = self.request("POST", path, params=params, data=mesh_bytes(mesh),
+                             headers={"Content-Type": "application/octet-stream",
+                                      "Accept": accept}, http_timeout=http_timeout)
+        if fmt == "ply":
+            out = parse_colored_ply(r.content)
+            out.headers = {k: v for k, v in r.headers.items() if k.lower().startswith("x-")}
+            return out
+        answer = r.json()
+        for key in ("colors", "point_colors"):
+            if key in answer:
+                answer[key] = np.asarray(answer[key], dtype=np.float64).reshape(-1, 3).astype(np.float32)
+        return answer
 
     # -- volumes --------------------------------------------------------------------------
 

@@ -1,0 +1,114 @@
+#include "mesh_service.h"
+
+#include <map>
+#include <mutex>
+
+#include "json_fields.h"
+
+namespace solidtex::server {
+
+using nlohmann::json;
+
+json mesh_summary(const Mesh& m) {
+  const MeshBounds b = m.bounds();
+  const MeshDefects& d = m.defects;
+  return {{"format", m.format},
+          {"vertices", int64_t(m.vertices.size())},
+          {"triangles", int64_t(m.triangles.size())},
+          {"bounds", {{"min", b.min}, {"max", b.max}}},
+          {"defects",
+           {{"duplicate_faces", d.duplicate_faces},
+            {"degenerate_faces", d.degenerate_faces},
+            {"unreferenced_vertices", d.unreferenced_vertices},
+            {"boundary_edges", d.boundary_edges},
+            {"non_manifold_edges", d.non_manifold_edges},
+            {"components", d.components},
+            {"polygons_triangulated", d.polygons_triangulated}}}};
+}
+
+struct MeshService::Impl {
+  DataStore& store;
+  ServerConfig config;
+  mutable std::mutex mutex;
+  std::map<std::string, json> meta;
+  std::map<std::string, std::shared_ptr<const Mesh>> decoded;
+  Impl(DataStore& s, const ServerConfig& c) : store(s), config(c) {}
+};
+
+MeshService::MeshService(DataStore& store, const ServerConfig& config) : impl_(std::make_unique<Impl>(store, config)) {}
+MeshService::~MeshService() = default;
+
+Status MeshService::start(std::vector<std::string>* report) {
+  for (const std::string& id : impl_->store.ids(ResourceKind::kMesh)) {
+    auto text = impl_->store.read_text(ResourceKind::kMesh, id, "meta.json");
+    auto j = text ? parse_json_text(*text, "meta.json") : Result<json>(text.status());
+    if (!j) {
+      if (report) report->push_back("skipped mesh " + id + ": " + j.status().to_string());
+      continue;
+    }
+    impl_->meta.emplace(id, *j);
+  }
+  return Status::ok();
+}
+
+Result<Mesh> MeshService::decode(std::span<const uint8_t> bytes) const { return decode_mesh(bytes, impl_->config.mesh_limits); }
+
+Result<json> MeshService::upload(std::span<const uint8_t> bytes, const std::string& name) {
+  SOLIDTEX_ASSIGN_OR_RETURN(Mesh m, decode(bytes));
+  const std::string id = DataStore::new_id("mesh_");
+  json j = mesh_summary(m);
+  j["id"] = id;
+  j["name"] = name;
+  SOLIDTEX_RETURN_IF_ERROR(impl_->store.create(ResourceKind::kMesh, id));
+  Status st = impl_->store.write(ResourceKind::kMesh, id, "source.mesh", bytes);
+  if (st.is_ok()) st = impl_->store.write_text(ResourceKind::kMesh, id, "meta.json", j.dump());
+  if (!st.is_ok()) {
+    impl_->store.remove(ResourceKind::kMesh, id);
+    return st;
+  }
+  std::lock_guard<std::mutex> g(impl_->mutex);
+  impl_->meta.emplace(id, j);
+  impl_->decoded.emplace(id, std::make_shared<const Mesh>(std::move(m)));
+  return j;
+}
+
+Result<json> MeshService::get(const std::string& id) const {
+  std::lock_guard<std::mutex> g(impl_->mutex);
+  auto it = impl_->meta.find(id);
+  if (it == impl_->meta.end()) return Status(StatusCode::kNotFound, "no mesh '" + id + "'", "id");
+  return it->second;
+}
+
+json MeshService::list() const {
+  std::lock_guard<std::mutex> g(impl_->mutex);
+  json out = json::array();
+  for (const auto& [id, j] : impl_->meta) out.push_back(j);
+  return {{"meshes", out}};
+}
+
+Status MeshService::remove(const std::string& id) {
+  std::lock_guard<std::mutex> g(impl_->mutex);
+  auto it = impl_->meta.find(id);
+  if (it == impl_->meta.end()) return Status(StatusCode::kNotFound, "no mesh '" + id + "'", "id");
+  SOLIDTEX_RETURN_IF_ERROR(impl_->store.remove(ResourceKind::kMesh, id));
+  impl_->meta.erase(it);
+  impl_->decoded.erase(id);
+  return Status::ok();
+}
+
+Result<std::shared_ptr<const Mesh>> MeshService::mesh(const std::string& id) {
+  {
+    std::lock_guard<std::mutex> g(impl_->mutex);
+    if (!impl_->meta.count(id)) return Status(StatusCode::kNotFound, "no mesh '" + id + "'", "mesh");
+    auto it = impl_->decoded.find(id);
+    if (it != impl_->decoded.end()) return it->second;
+  }
+  SOLIDTEX_ASSIGN_OR_RETURN(auto bytes, impl_->store.read(ResourceKind::kMesh, id, "source.mesh"));
+  SOLIDTEX_ASSIGN_OR_RETURN(Mesh m, decode(bytes));
+  auto shared = std::make_shared<const Mesh>(std::move(m));
+  std::lock_guard<std::mutex> g(impl_->mutex);
+  impl_->decoded.emplace(id, shared);
+  return shared;
+}
+
+}  // namespace solidtex::server
