@@ -101,14 +101,14 @@ class Server {
     SOLIDTEX_ASSIGN_OR_RETURN(store_, DataStore::open(config_.data_dir, &report));
     exemplars_ = std::make_unique<ExemplarService>(*store_, config_);
     fields_ = std::make_unique<FieldService>(*store_, config_);
-    volumes_ = std::make_unique<VolumeService>(*store_, config_, *exemplars_, *fields_);
     meshes_ = std::make_unique<MeshService>(*store_, config_);
+    volumes_ = std::make_unique<VolumeService>(*store_, config_, *exemplars_, *fields_, *meshes_);
     pool_ = std::make_unique<WorkerPool>(config_.threads, config_.queue);
     api_ = std::make_unique<Api>(config_, *exemplars_, *fields_, *volumes_, *meshes_, metrics_, *pool_, abort_running_);
     SOLIDTEX_RETURN_IF_ERROR(fields_->start(&report));
     SOLIDTEX_RETURN_IF_ERROR(exemplars_->start(&report));
-    SOLIDTEX_RETURN_IF_ERROR(volumes_->start(&report));
     SOLIDTEX_RETURN_IF_ERROR(meshes_->start(&report));
+    SOLIDTEX_RETURN_IF_ERROR(volumes_->start(&report));
     for (const std::string& line : report) std::cerr << "solidtex serve: " << line << "\n";
 
     // Signals go to the main thread only (sigwait below), never to I/O or worker threads.

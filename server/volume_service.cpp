@@ -66,13 +66,24 @@ struct VolumeService::Impl {
   ServerConfig config;
   ExemplarService& exemplars;
   FieldService& fields;
+  MeshService& meshes;
   mutable std::mutex mutex;
   std::map<std::string, std::shared_ptr<Volume>> volumes;
   std::atomic<int64_t> voxels_total{0};
   std::vector<std::weak_ptr<Synthesizer>> live;  // every synthesizer built (guarded by mutex)
 
-  Impl(DataStore& s, const ServerConfig& c, ExemplarService& e, FieldService& f)
-      : store(s), config(c), exemplars(e), fields(f) {}
+  Impl(DataStore& s, const ServerConfig& c, ExemplarService& e, FieldService& f, MeshService& m)
+      : store(s), config(c), exemplars(e), fields(f), meshes(m) {}
+
+  // The surface-distance label's mesh: from the mesh service when creating (bytes copied into
+  // `mesh_bytes`), from the volume's own copy when loading.
+  Status attach_surface(Volume& v, const json& mesh_spec, const std::vector<uint8_t>& bytes) {
+    SOLIDTEX_ASSIGN_OR_RETURN(Mesh mesh, meshes.decode(bytes));
+    SOLIDTEX_ASSIGN_OR_RETURN(Placement placement,
+                              placement_from_json(mesh_spec.value("placement", json::object()), "regions.mesh.placement", mesh.bounds(), nullptr));
+    SOLIDTEX_ASSIGN_OR_RETURN(v.label->surface, SurfaceDistance::create(mesh, placement, v.label->distance + 1));
+    return Status::ok();
+  }
 
   // Parses a spec (strictly) into a Volume; `field_bytes` receives the stored field to copy.
   Result<std::shared_ptr<Volume>> parse_spec(const json& j, std::vector<uint8_t>* field_bytes, json* field_desc) {
@@ -86,7 +97,7 @@ struct VolumeService::Impl {
       v->exemplar_ids.push_back(e);
     } else {
       const json& r = j["regions"];
-      SOLIDTEX_RETURN_IF_ERROR(check_keys(r, {"exemplars", "label"}, "regions"));
+      SOLIDTEX_RETURN_IF_ERROR(check_keys(r, {"exemplars", "label", "mesh"}, "regions"));
       if (!r.contains("exemplars") || !r["exemplars"].is_array() || r["exemplars"].size() != 2)
         return Status(StatusCode::kInvalidArgument, "must be an array of two exemplar ids", "regions.exemplars");
       for (size_t i = 0; i < 2; ++i) {
@@ -98,6 +109,15 @@ struct VolumeService::Impl {
       auto parsed = RegionLabel::parse(label);
       if (!parsed) return Status(StatusCode::kInvalidArgument, parsed.status().message(), "regions.label");
       v->label = *parsed;
+      const bool shell = parsed->kind == RegionLabel::Kind::kSurfaceShell;
+      if (shell != r.contains("mesh"))
+        return Status(StatusCode::kInvalidArgument, shell ? "a surface label needs {\"id\", \"placement\"} of a mesh" : "only a surface label takes a mesh",
+                      "regions.mesh");
+      if (shell) {
+        SOLIDTEX_RETURN_IF_ERROR(check_keys(r["mesh"], {"id", "placement"}, "regions.mesh"));
+        if (!r["mesh"].contains("id")) return Status(StatusCode::kInvalidArgument, "is required", "regions.mesh.id");
+        SOLIDTEX_RETURN_IF_ERROR(json_string(r["mesh"]["id"], "regions.mesh.id", 64).status());
+      }
     }
     if (j.contains("seed")) {
       SOLIDTEX_ASSIGN_OR_RETURN(auto s, json_int(j["seed"], "seed", 0, int64_t(1) << 30));
@@ -207,8 +227,8 @@ struct VolumeService::Impl {
 };
 
 VolumeService::VolumeService(DataStore& store, const ServerConfig& config, ExemplarService& exemplars,
-                             FieldService& fields)
-    : impl_(std::make_unique<Impl>(store, config, exemplars, fields)) {}
+                             FieldService& fields, MeshService& meshes)
+    : impl_(std::make_unique<Impl>(store, config, exemplars, fields, meshes)) {}
 VolumeService::~VolumeService() = default;
 
 Status VolumeService::start(std::vector<std::string>* report) {
@@ -222,6 +242,10 @@ Status VolumeService::start(std::vector<std::string>* report) {
       if (info["field"].value("kind", "") == "stored") {
         SOLIDTEX_ASSIGN_OR_RETURN(auto field, load_field(impl_->store.path(ResourceKind::kVolume, id, "field.stf")));
         v->field = field;
+      }
+      if (v->label && v->label->kind == RegionLabel::Kind::kSurfaceShell) {
+        SOLIDTEX_ASSIGN_OR_RETURN(auto bytes, impl_->store.read(ResourceKind::kVolume, id, "mesh.source"));
+        SOLIDTEX_RETURN_IF_ERROR(impl_->attach_surface(*v, spec["regions"]["mesh"], bytes));
       }
       v->info = info;
       return v;
@@ -248,6 +272,14 @@ Result<json> VolumeService::create(const std::string& spec_text) {
     v->field = field;
   }
   SOLIDTEX_RETURN_IF_ERROR(impl_->check_exemplars_ready(*v));
+  std::vector<uint8_t> mesh_bytes;
+  if (v->label && v->label->kind == RegionLabel::Kind::kSurfaceShell) {
+    const json& ms = spec["regions"]["mesh"];
+    const std::string mesh_id = ms["id"].get<std::string>();
+    SOLIDTEX_RETURN_IF_ERROR(impl_->meshes.mesh(mesh_id).status());  // 404 when unknown
+    SOLIDTEX_ASSIGN_OR_RETURN(mesh_bytes, impl_->store.read(ResourceKind::kMesh, mesh_id, "source.mesh"));
+    SOLIDTEX_RETURN_IF_ERROR(impl_->attach_surface(*v, ms, mesh_bytes));
+  }
   const std::string id = DataStore::new_id("vol_");
   SOLIDTEX_RETURN_IF_ERROR(impl_->store.create(ResourceKind::kVolume, id));
   v->info = {{"id", id},
@@ -260,6 +292,7 @@ Result<json> VolumeService::create(const std::string& spec_text) {
              {"params", v->params_spec},
              {"spec", spec}};
   Status st = field_bytes.empty() ? Status::ok() : impl_->store.write(ResourceKind::kVolume, id, "field.stf", field_bytes);
+  if (st.is_ok() && !mesh_bytes.empty()) st = impl_->store.write(ResourceKind::kVolume, id, "mesh.source", mesh_bytes);
   if (st.is_ok()) st = impl_->store.write_text(ResourceKind::kVolume, id, "volume.json", v->info.dump());
   if (!st.is_ok()) {
     impl_->store.remove(ResourceKind::kVolume, id);

@@ -2,7 +2,8 @@
 // frame field and synthesis parameters, queried lazily by cuts, boxes and points.
 //
 // A volume is immutable: volume.json keeps the spec as given, and a stored field is copied
-// into the volume (field.stf) at creation. Synthesizers (and their voxel caches) are built at
+// into the volume (field.stf) at creation, and so is the mesh of a surface-distance label
+// (mesh.source; regions {"label": "surface:D", "mesh": {"id", "placement"}}). Synthesizers (and their voxel caches) are built at
 // the first query and kept; the service-wide cache budget (--cache-mb) is split evenly over
 // the live synthesizers. Because synthesis is spatially deterministic, a query answers the
 // same bits whichever request, order, thread count or cache state computed its voxels, and the
@@ -20,6 +21,7 @@
 #include "data_store.h"
 #include "exemplar_service.h"
 #include "field_service.h"
+#include "mesh_service.h"
 #include "interrupter.h"
 #include "server_config.h"
 #include "target.h"
@@ -34,7 +36,8 @@ struct QueryResult {
 
 class VolumeService {
  public:
-  VolumeService(DataStore& store, const ServerConfig& config, ExemplarService& exemplars, FieldService& fields);
+  VolumeService(DataStore& store, const ServerConfig& config, ExemplarService& exemplars, FieldService& fields,
+                MeshService& meshes);
   ~VolumeService();
 
   Status start(std::vector<std::string>* report);

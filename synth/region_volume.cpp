@@ -7,6 +7,7 @@ namespace solidtex {
 
 int RegionLabel::label_of(const WorldPoint& p) const {
   if (kind == Kind::kHalfSpace) return normal.x * p.x + normal.y * p.y + normal.z * p.z >= offset ? 1 : 0;
+  if (kind == Kind::kSurfaceShell) return surface && surface->at(p) <= distance ? 1 : 0;
   return p.x >= min.x && p.y >= min.y && p.z >= min.z && p.x <= max.x && p.y <= max.y && p.z <= max.z ? 1 : 0;
 }
 
@@ -30,7 +31,14 @@ Result<RegionLabel> RegionLabel::parse(const std::string& spec) {
     l.max = {v[3], v[4], v[5]};
     return l;
   }
-  return Status(StatusCode::kInvalidArgument, "'" + spec + "' is not halfspace:NX,NY,NZ,D or box:X0,Y0,Z0,X1,Y1,Z1",
+  if (spec.rfind("surface:", 0) == 0) {
+    SOLIDTEX_ASSIGN_OR_RETURN(auto v, parse_number_list(spec.substr(8), 1, "regions"));
+    if (!(v[0] >= 0.5 && v[0] <= 64)) return Status(StatusCode::kInvalidArgument, "surface distance must be in [0.5, 64] voxels", "regions");
+    l.kind = Kind::kSurfaceShell;
+    l.distance = v[0];
+    return l;
+  }
+  return Status(StatusCode::kInvalidArgument, "'" + spec + "' is not halfspace:NX,NY,NZ,D, box:X0,Y0,Z0,X1,Y1,Z1 or surface:D",
                 "regions");
 }
 
@@ -39,6 +47,8 @@ Result<std::shared_ptr<RegionVolume>> RegionVolume::create(std::vector<std::shar
   if (regions.size() != 2) return Status(StatusCode::kInvalidArgument, "needs exactly two region textures", "regions");
   for (const auto& r : regions)
     if (!r) return Status(StatusCode::kInvalidArgument, "a region has no texture", "regions");
+  if (label.kind == RegionLabel::Kind::kSurfaceShell && !label.surface)
+    return Status(StatusCode::kInvalidArgument, "a surface label needs a mesh", "regions.mesh");
   auto v = std::shared_ptr<RegionVolume>(new RegionVolume());
   v->regions_ = std::move(regions);
   v->label_ = label;

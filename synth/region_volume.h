@@ -10,19 +10,23 @@
 #include <string>
 #include <vector>
 
+#include "mesh_distance.h"
 #include "synthesizer.h"
 
 namespace solidtex {
 
 struct RegionLabel {
-  enum class Kind { kHalfSpace, kBox };
+  enum class Kind { kHalfSpace, kBox, kSurfaceShell };
   Kind kind = Kind::kHalfSpace;
   WorldPoint normal{1, 0, 0};  // half-space: label 1 where normal . p >= offset, else 0
   double offset = 0;
   WorldPoint min, max;         // box: label 1 inside [min, max], else 0
+  double distance = 0;         // surface shell: label 1 within `distance` of the surface, else 0
+  std::shared_ptr<const SurfaceDistance> surface;  // required by kSurfaceShell (set after parse)
 
   int label_of(const WorldPoint& p) const;
-  // "halfspace:NX,NY,NZ,D" or "box:X0,Y0,Z0,X1,Y1,Z1" (world units).
+  // "halfspace:NX,NY,NZ,D", "box:X0,Y0,Z0,X1,Y1,Z1" or "surface:D" (world units); a surface
+  // label still needs its `surface` (a placed mesh) before use.
   static Result<RegionLabel> parse(const std::string& spec);
 };
 
