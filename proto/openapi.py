@@ -53,7 +53,9 @@ S = {
  "Field": {"type": "object", "required": ["id", "revision"], "properties": {
      "id": {"type": "string"}, "revision": {"type": "integer", "description": "1 at creation, +1 per added curve."},
      "curves": {"type": "integer"}, "dims": {"type": "array", "items": {"type": "integer"}}, "origin": {"type": "array", "items": {"type": "number"}},
-     "spacing": {"type": "number"}, "singular_nodes": {"type": "integer"}, "residual": {"type": "number"}, "seconds": {"type": "number"}, "has_scales": {"type": "boolean"}}},
+     "spacing": {"type": "number"}, "singular_nodes": {"type": "integer"}, "residual": {"type": "number"}, "seconds": {"type": "number"}, "has_scales": {"type": "boolean"},
+     "from_mesh": {"type": "object", "description": "Only in the answer of POST /v1/fields/from-mesh: kind, frames and curves used, dropped_curves (crest chains that define no frame), placement {scale, translate}."}},
+     "description": "`curves` counts sketch elements: each curve, plus one for a batch of explicit frames."},
  "Frames": {"type": "object", "properties": {"points": {"type": "array", "items": {"type": "array", "items": {"type": "number"}}},
      "quaternions": {"type": "array", "description": "Unit quaternions (w, x, y, z) at the points.", "items": {"type": "array", "items": {"type": "number"}}},
      "scales": {"type": "array", "description": "Per-axis scales at the points (1,1,1 without a scale field).", "items": {"type": "array", "items": {"type": "number"}}}}},
@@ -69,7 +71,7 @@ S = {
      "size": {"type": "array", "items": {"type": "integer"}, "minItems": 2, "maxItems": 2, "description": "W, H."}}},
  "Mesh": {"type": "object", "required": ["id"], "properties": {
      "id": {"type": "string"}, "name": {"type": "string"}, "format": {"type": "string", "enum": ["ply", "obj", "off"]},
-     "vertices": {"type": "integer"}, "triangles": {"type": "integer", "description": "After fan triangulation of polygons and removal of duplicate and degenerate faces."},
+     "vertices": {"type": "integer", "description": "Every vertex position of the file, unreferenced ones included (they get colours too); OBJ texture coordinates and normals are ignored."}, "triangles": {"type": "integer", "description": "After fan triangulation of polygons and removal of duplicate and degenerate faces."},
      "bounds": {"type": "object", "properties": {"min": {"type": "array", "items": {"type": "number"}}, "max": {"type": "array", "items": {"type": "number"}}}},
      "defects": {"type": "object", "description": "What the reader tolerated: duplicate_faces and degenerate_faces (dropped), unreferenced_vertices, boundary_edges (holes), non_manifold_edges, components.",
                  "properties": {k: {"type": "integer"} for k in ["duplicate_faces", "degenerate_faces", "unreferenced_vertices", "boundary_edges", "non_manifold_edges", "components", "polygons_triangulated"]}}}},
@@ -90,7 +92,7 @@ S = {
      "mesh": {"type": "string"}, "kind": {"type": "string", "enum": ["curvature", "features"], "description": "curvature: principal-curvature frames at surface vertices (Gorla et al.), x along the direction of least curvature, y along the normal; features: crest lines (edges whose dihedral angle exceeds feature_angle_degrees, chained) and any user `curves`, used as sketch curves with x along the curve."},
      "placement": ref("Placement"),
      "shortest_side_cells": {"type": "integer", "minimum": 2, "maximum": 256, "default": 24},
-     "max_constraints": {"type": "integer", "minimum": 1, "maximum": 20000, "default": 2000, "description": "curvature: at most this many vertex frames (evenly subsampled)."},
+     "max_constraints": {"type": "integer", "minimum": 1, "maximum": 20000, "default": 2000, "description": "curvature: at most this many vertex frames: one per occupied cube of the field's grid spacing (the cube grows by 25% until the budget holds), so usually fewer."},
      "feature_angle_degrees": {"type": "number", "minimum": 1, "maximum": 179, "default": 60},
      "curves": {"type": "array", "description": "features: user polylines on the surface (mesh coordinates); normals are taken from the nearest vertices.", "items": {"type": "array", "items": {"type": "array", "items": {"type": "number"}, "minItems": 3, "maxItems": 3}}}}},
  "Stats": {"type": "object", "properties": {"volume": {"type": "string"}, "levels": {"type": "array", "items": {"type": "object", "properties": {"level": {"type": "integer"}, "voxels_synthesized": {"type": "integer"}, "cached_voxels": {"type": "integer"}}}},
