@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Runs every benchmark in bench/ and prints one JSON document:
-#   {"analysis": [...], "slice": {...}, "field": {...}, "service": {...}}. Takes about 20 minutes on 2 cores.
+#   {"analysis": [...], "slice": {...}, "field": {...}, "surface": {...}, "service": {...}}. Takes about an hour on 2 cores.
 # Uses ../shared/data/exemplars/wood_grain.png when present, else a procedural wood exemplar.
 set -euo pipefail
 build=${1:-build}
@@ -26,6 +26,12 @@ echo '"slice":'
 "$build/bin/bench_slice" "$tmp/wood.stx" $quick
 echo ', "field":'
 "$build/bin/bench_field"
+echo ', "surface":'
+if [ -d "$shared/data/meshes" ]; then
+  "$build/bin/bench_surface" "$tmp/wood.stx" "$shared/data/meshes" --resolutions 512,1024 --synthesize-up-to 4000000
+else
+  echo '{"skipped": "no ../shared/data/meshes"}'
+fi
 echo ', "service":'
 "$(cd "$(dirname "$0")/.." && pwd)/scripts/setup-python.sh" "$(cd "$build" && pwd)"
 "$build/venv/bin/python" "$(dirname "$0")/../bench/bench_service.py" "$build"
