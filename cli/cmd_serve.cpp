@@ -1,7 +1,7 @@
 // solidtex serve [--host 127.0.0.1] [--port 8080] [--data DIR] [--threads N] [--io-threads N]
 //   [--queue N] [--deadline S] [--max-deadline S] [--cache-mb M] [--max-upload-mb M]
 //   [--max-image-side PX] [--max-image-pixels N] [--max-voxels N] [--max-field-nodes N]
-//   [--max-jobs N] [--analysis-threads N]
+//   [--max-jobs N] [--analysis-threads N] [--max-mesh-vertices N] [--max-mesh-faces N]
 #include "args.h"
 #include "commands.h"
 #include "http_server.h"
@@ -11,7 +11,7 @@ namespace solidtex::cli {
 Status run_serve(const std::vector<std::string>& argv) {
   Args args({"--host", "--port", "--data", "--threads", "--io-threads", "--queue", "--deadline", "--max-deadline",
              "--cache-mb", "--max-upload-mb", "--max-image-side", "--max-image-pixels", "--max-voxels",
-             "--max-field-nodes", "--max-jobs", "--analysis-threads"},
+             "--max-field-nodes", "--max-jobs", "--analysis-threads", "--max-mesh-vertices", "--max-mesh-faces"},
             {});
   SOLIDTEX_RETURN_IF_ERROR(args.parse(argv));
   if (!args.positionals().empty())
@@ -37,6 +37,10 @@ Status run_serve(const std::vector<std::string>& argv) {
   c.max_voxels = int64_t(voxels);
   SOLIDTEX_ASSIGN_OR_RETURN(double nodes, args.get_double("--max-field-nodes", double(c.max_field_nodes), 8, double(int64_t(1) << 24)));
   c.max_field_nodes = int64_t(nodes);
+  SOLIDTEX_ASSIGN_OR_RETURN(double mesh_vertices, args.get_double("--max-mesh-vertices", double(c.mesh_limits.max_vertices), 3, 1e8));
+  c.mesh_limits.max_vertices = int64_t(mesh_vertices);
+  SOLIDTEX_ASSIGN_OR_RETURN(double mesh_faces, args.get_double("--max-mesh-faces", double(c.mesh_limits.max_faces), 1, 2e8));
+  c.mesh_limits.max_faces = int64_t(mesh_faces);
   SOLIDTEX_ASSIGN_OR_RETURN(c.max_jobs, args.get_int("--max-jobs", c.max_jobs, 1, 1000));
   SOLIDTEX_ASSIGN_OR_RETURN(c.analysis_threads, args.get_int("--analysis-threads", c.analysis_threads, 1, 16));
   return server::run_server(c);

@@ -71,3 +71,15 @@ def test_surface_shell_takes_the_second_texture_near_the_surface(server, exempla
                      params={"axis": "z", "at": 24, "size": "48,48", "timeout": 300}, headers=RAW32, timeout=300)
     assert r.status_code == 200, r.text
     assert np.array_equal(np.frombuffer(r.content, dtype="<f4").reshape(48, 48, 3), s)
+
+
+def test_meshes_survive_kill_9(server):
+    off = b"OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n"
+    srv = server()
+    m = srv.client.upload_mesh(off, name="tet")
+    srv.kill()
+    srv2 = server(data_dir=srv.data_dir)
+    assert srv2.client.get_mesh(m["id"]) == m
+    assert [x["id"] for x in srv2.client.list_meshes()] == [m["id"]]
+    ply = srv2.client.get_mesh_file(m["id"])
+    assert ply.startswith(b"ply\nformat binary_little_endian 1.0\n")
