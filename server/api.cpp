@@ -142,6 +142,24 @@ Result<std::unique_ptr<RequestInterrupter>> Api::interrupter_for(const HttpReque
   return std::make_unique<RequestInterrupter>(deadline, r.disconnected, &shutting_down_);
 }
 
+template <typename F>
+auto Api::interruptible(const HttpRequest& r, const std::string& timeout, const std::string& what, F&& work)
+    -> decltype(work(std::declval<Interrupter&>())) {
+  auto made = interrupter_for(r, timeout);
+  if (!made) return made.status();
+  RequestInterrupter& interrupter = **made;
+  if (interrupter.was_interrupted()) return interrupter.interruption_status(what);
+  auto result = work(interrupter);
+  if (!result && result.status().code() == StatusCode::kCancelled) return interrupter.interruption_status(what);
+  return result;
+}
+
+Result<QueryResult> Api::query_volume(const HttpRequest& r, const std::string& kind, const TargetSet& target,
+                                      const std::string& timeout) {
+  return interruptible(r, timeout, "the " + kind,
+                       [&](Interrupter& i) { return volumes_.query(r.param("id"), kind, target, i); });
+}
+
 HttpResponse Api::healthz(const HttpRequest& r) {
   if (Status s = no_query(r); !s.is_ok()) return HttpResponse::error(s);
   return HttpResponse::json(200, {{"status", shutting_down_.load() ? "stopping" : "ok"},
@@ -236,9 +254,8 @@ HttpResponse Api::create_field(const HttpRequest& r) {
   auto result = [&]() -> Result<HttpResponse> {
     SOLIDTEX_ASSIGN_OR_RETURN(QueryParams q, QueryParams::parse(r.query, {"timeout"}));
     SOLIDTEX_RETURN_IF_ERROR(require_json_body(r));
-    SOLIDTEX_ASSIGN_OR_RETURN(auto interrupter, interrupter_for(r, q.get("timeout").value_or("")));
-    auto created = fields_.create(r.body, *interrupter);
-    if (!created && created.status().code() == StatusCode::kCancelled) return interrupter->interruption_status("the field solve");
+    auto created = interruptible(r, q.get("timeout").value_or(""), "the field solve",
+                                 [&](Interrupter& i) { return fields_.create(r.body, i); });
     if (!created) return created.status();
     HttpResponse out = HttpResponse::json(201, *created);
     out.headers.push_back({"Location", "/v1/fields/" + (*created)["id"].get<std::string>()});
@@ -257,9 +274,8 @@ HttpResponse Api::add_curve(const HttpRequest& r) {
   auto result = [&]() -> Result<HttpResponse> {
     SOLIDTEX_ASSIGN_OR_RETURN(QueryParams q, QueryParams::parse(r.query, {"timeout"}));
     SOLIDTEX_RETURN_IF_ERROR(require_json_body(r));
-    SOLIDTEX_ASSIGN_OR_RETURN(auto interrupter, interrupter_for(r, q.get("timeout").value_or("")));
-    auto updated = fields_.add_curve(r.param("id"), r.body, *interrupter);
-    if (!updated && updated.status().code() == StatusCode::kCancelled) return interrupter->interruption_status("the field solve");
+    auto updated = interruptible(r, q.get("timeout").value_or(""), "the field solve",
+                                 [&](Interrupter& i) { return fields_.add_curve(r.param("id"), r.body, i); });
     if (!updated) return updated.status();
     return HttpResponse::json(200, *updated);
   }();
@@ -299,15 +315,11 @@ HttpResponse Api::delete_volume(const HttpRequest& r) { return respond_status(vo
 
 Result<HttpResponse> Api::synthesize_image(const HttpRequest& r, const std::string& kind, const TargetSet& target,
                                            const std::string& timeout) {
-  SOLIDTEX_ASSIGN_OR_RETURN(auto interrupter, interrupter_for(r, timeout));
-  if (interrupter->was_interrupted()) return interrupter->interruption_status("the " + kind);
-  auto q = volumes_.query(r.param("id"), kind, target, *interrupter);
-  if (!q && q.status().code() == StatusCode::kCancelled) return interrupter->interruption_status("the " + kind);
-  if (!q) return q.status();
+  SOLIDTEX_ASSIGN_OR_RETURN(auto q, query_volume(r, kind, target, timeout));
   const std::string shape = std::to_string(target.height) + "," + std::to_string(target.width) + ",3";
   SOLIDTEX_ASSIGN_OR_RETURN(HttpResponse out,
-                            encode_colours(q->rgb, target.width, target.height, shape, negotiate(r.accept, Encoding::kPng)));
-  out.headers.push_back({"X-Voxels-Synthesized", std::to_string(q->voxels_synthesized)});
+                            encode_colours(q.rgb, target.width, target.height, shape, negotiate(r.accept, Encoding::kPng)));
+  out.headers.push_back({"X-Voxels-Synthesized", std::to_string(q.voxels_synthesized)});
   return out;
 }
 
@@ -361,9 +373,7 @@ HttpResponse Api::region(const HttpRequest& r) {
     if (size[0] < 1 || size[1] < 1 || size[2] < 1) return Status(StatusCode::kInvalidArgument, "must be positive", "size");
     SOLIDTEX_RETURN_IF_ERROR(volumes_.check_target_size(int64_t(size[0]) * size[1] * size[2], "size"));
     SOLIDTEX_ASSIGN_OR_RETURN(TargetSet target, TargetSet::box(Voxel{min[0], min[1], min[2]}, size[0], size[1], size[2]));
-    SOLIDTEX_ASSIGN_OR_RETURN(auto interrupter, interrupter_for(r, q.get("timeout").value_or("")));
-    auto qr = volumes_.query(r.param("id"), "region", target, *interrupter);
-    if (!qr && qr.status().code() == StatusCode::kCancelled) return interrupter->interruption_status("the region");
+    auto qr = query_volume(r, "region", target, q.get("timeout").value_or(""));
     if (!qr) return qr.status();
     const Encoding enc = negotiate(r.accept, Encoding::kVdb);
     HttpResponse out;
@@ -417,9 +427,7 @@ HttpResponse Api::points(const HttpRequest& r) {
     }
     if (pts.empty()) return Status(StatusCode::kInvalidArgument, "holds no points", "body");
     SOLIDTEX_ASSIGN_OR_RETURN(TargetSet target, TargetSet::points(pts));
-    SOLIDTEX_ASSIGN_OR_RETURN(auto interrupter, interrupter_for(r, q.get("timeout").value_or("")));
-    auto qr = volumes_.query(r.param("id"), "points", target, *interrupter);
-    if (!qr && qr.status().code() == StatusCode::kCancelled) return interrupter->interruption_status("the points query");
+    auto qr = query_volume(r, "points", target, q.get("timeout").value_or(""));
     if (!qr) return qr.status();
     const Encoding enc = r.accept.find("application/json") != std::string::npos ? Encoding::kJson : Encoding::kFloat32;
     SOLIDTEX_ASSIGN_OR_RETURN(HttpResponse out,
@@ -506,9 +514,7 @@ HttpResponse Api::surface(const HttpRequest& r) {
     for (const auto& v : mesh->vertices) world.push_back(placement.apply(v));
     for (const auto& p : extra) world.push_back(placement.apply(p));
     SOLIDTEX_ASSIGN_OR_RETURN(TargetSet target, TargetSet::points(world));
-    SOLIDTEX_ASSIGN_OR_RETURN(auto interrupter, interrupter_for(r, timeout));
-    auto qr = volumes_.query(r.param("id"), "surface", target, *interrupter);
-    if (!qr && qr.status().code() == StatusCode::kCancelled) return interrupter->interruption_status("the surface");
+    auto qr = query_volume(r, "surface", target, timeout);
     if (!qr) return qr.status();
     const int64_t bounding = bounding_voxels(mesh->bounds(), placement);
     HttpResponse out;
@@ -577,9 +583,8 @@ HttpResponse Api::field_from_mesh(const HttpRequest& r) {
         o.curves.push_back(std::move(line));
       }
     }
-    SOLIDTEX_ASSIGN_OR_RETURN(auto interrupter, interrupter_for(r, q.get("timeout").value_or("")));
-    auto created = fields_.create_from_mesh(*mesh, o, *interrupter);
-    if (!created && created.status().code() == StatusCode::kCancelled) return interrupter->interruption_status("the field solve");
+    auto created = interruptible(r, q.get("timeout").value_or(""), "the field solve",
+                                 [&](Interrupter& i) { return fields_.create_from_mesh(*mesh, o, i); });
     if (!created) return created.status();
     HttpResponse out = HttpResponse::json(201, *created);
     out.headers.push_back({"Location", "/v1/fields/" + (*created)["id"].get<std::string>()});
