@@ -6,10 +6,10 @@
 
 #include <iostream>
 
-#include "analysis.h"
-#include "image_io.h"
-#include "procedural_exemplar.h"
-#include "table_file.h"
+#include "analysis/analysis.h"
+#include "core/image_io.h"
+#include "testkit/procedural_exemplar.h"
+#include "analysis/table_file.h"
 
 int main(int argc, char** argv) {
   using namespace solidtex;

@@ -8,8 +8,8 @@
 #include <cmath>
 #include <iostream>
 
-#include "hash.h"
-#include "tensor_field.h"
+#include "core/hash.h"
+#include "field/tensor_field.h"
 
 using namespace solidtex;
 

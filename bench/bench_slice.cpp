@@ -12,8 +12,8 @@
 #include <cstring>
 #include <iostream>
 
-#include "synthesizer.h"
-#include "table_file.h"
+#include "synthesis/synthesizer.h"
+#include "analysis/table_file.h"
 
 using namespace solidtex;
 

@@ -12,11 +12,11 @@
 #include <cstring>
 #include <iostream>
 
-#include "image_io.h"
-#include "mesh.h"
-#include "number_list.h"
-#include "synthesizer.h"
-#include "table_file.h"
+#include "core/image_io.h"
+#include "mesh/mesh.h"
+#include "core/number_list.h"
+#include "synthesis/synthesizer.h"
+#include "analysis/table_file.h"
 
 using namespace solidtex;
 

@@ -1,6 +1,6 @@
 #include "args.h"
 
-#include "number_list.h"
+#include "core/number_list.h"
 
 #include <cctype>
 #include <charconv>

@@ -6,13 +6,13 @@
 #include <filesystem>
 #include <iostream>
 
-#include "analysis.h"
+#include "analysis/analysis.h"
 #include "args.h"
-#include "byte_io.h"
+#include "core/byte_io.h"
 #include "commands.h"
-#include "image_io.h"
+#include "core/image_io.h"
 #include "progress_bar.h"
-#include "table_file.h"
+#include "analysis/table_file.h"
 
 namespace solidtex::cli {
 namespace {

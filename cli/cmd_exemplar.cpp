@@ -3,8 +3,8 @@
 
 #include "args.h"
 #include "commands.h"
-#include "image_io.h"
-#include "procedural_exemplar.h"
+#include "core/image_io.h"
+#include "testkit/procedural_exemplar.h"
 
 namespace solidtex::cli {
 

@@ -7,9 +7,9 @@
 
 #include "args.h"
 #include "commands.h"
-#include "field_file.h"
-#include "sketch.h"
-#include "tensor_field.h"
+#include "field/field_file.h"
+#include "field/sketch.h"
+#include "field/tensor_field.h"
 
 namespace solidtex::cli {
 

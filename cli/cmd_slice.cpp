@@ -7,14 +7,14 @@
 #include <iostream>
 
 #include "args.h"
-#include "byte_io.h"
+#include "core/byte_io.h"
 #include "commands.h"
-#include "image_io.h"
+#include "core/image_io.h"
 #include "progress_bar.h"
-#include "quality.h"
-#include "region_volume.h"
-#include "synthesizer.h"
-#include "table_file.h"
+#include "testkit/quality.h"
+#include "synthesis/region_volume.h"
+#include "synthesis/synthesizer.h"
+#include "analysis/table_file.h"
 
 namespace solidtex::cli {
 

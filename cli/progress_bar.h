@@ -5,7 +5,7 @@
 #include <atomic>
 #include <string>
 
-#include "interrupter.h"
+#include "core/interrupter.h"
 
 namespace solidtex::cli {
 

@@ -3,9 +3,9 @@
 #include <cstring>
 
 #include "http_errors.h"
-#include "image_io.h"
+#include "core/image_io.h"
 #include "api_json.h"
-#include "json_fields.h"
+#include "core/json_fields.h"
 #include "openapi_document.h"
 #include "query_params.h"
 #include "vdb_export.h"

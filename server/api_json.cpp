@@ -1,6 +1,6 @@
 #include "api_json.h"
 
-#include "json_fields.h"
+#include "core/json_fields.h"
 
 namespace solidtex::server {
 

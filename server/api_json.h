@@ -5,10 +5,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include "analysis.h"
-#include "analysis_params.h"
-#include "mesh.h"
-#include "synthesis_params.h"
+#include "analysis/analysis.h"
+#include "analysis/analysis_params.h"
+#include "mesh/mesh.h"
+#include "synthesis/synthesis_params.h"
 
 namespace solidtex::server {
 

@@ -5,8 +5,8 @@
 #include <fstream>
 #include <random>
 
-#include "byte_io.h"
-#include "image_io.h"
+#include "core/byte_io.h"
+#include "core/image_io.h"
 
 namespace fs = std::filesystem;
 

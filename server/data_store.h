@@ -20,7 +20,7 @@
 #include <string>
 #include <vector>
 
-#include "status.h"
+#include "core/status.h"
 
 namespace solidtex::server {
 

@@ -7,12 +7,12 @@
 #include <mutex>
 #include <thread>
 
-#include "analysis.h"
+#include "analysis/analysis.h"
 #include "api_json.h"
-#include "exemplar.h"
-#include "image_io.h"
-#include "json_fields.h"
-#include "table_file.h"
+#include "analysis/exemplar.h"
+#include "core/image_io.h"
+#include "core/json_fields.h"
+#include "analysis/table_file.h"
 
 namespace solidtex::server {
 

@@ -19,10 +19,10 @@
 #include <utility>
 #include <vector>
 
-#include "analysis_params.h"
+#include "analysis/analysis_params.h"
 #include "data_store.h"
 #include "server_config.h"
-#include "table.h"
+#include "analysis/table.h"
 
 namespace solidtex::server {
 

@@ -5,10 +5,10 @@
 #include <mutex>
 
 #include "api_json.h"
-#include "json_fields.h"
-#include "mesh_geometry.h"
-#include "sketch.h"
-#include "tensor_field.h"
+#include "core/json_fields.h"
+#include "mesh/mesh_geometry.h"
+#include "field/sketch.h"
+#include "field/tensor_field.h"
 
 namespace solidtex::server {
 

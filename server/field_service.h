@@ -13,9 +13,9 @@
 #include <string>
 
 #include "data_store.h"
-#include "field_file.h"
-#include "interrupter.h"
-#include "mesh.h"
+#include "field/field_file.h"
+#include "core/interrupter.h"
+#include "mesh/mesh.h"
 #include "server_config.h"
 
 namespace solidtex::server {

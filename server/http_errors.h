@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "status.h"
+#include "core/status.h"
 
 namespace solidtex::server {
 

@@ -6,7 +6,7 @@
 #pragma once
 
 #include "server_config.h"
-#include "status.h"
+#include "core/status.h"
 
 namespace solidtex::server {
 

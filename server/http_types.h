@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "request_interrupter.h"
-#include "status.h"
+#include "core/status.h"
 
 namespace solidtex::server {
 

@@ -3,7 +3,7 @@
 #include <map>
 #include <mutex>
 
-#include "json_fields.h"
+#include "core/json_fields.h"
 
 namespace solidtex::server {
 

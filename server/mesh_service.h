@@ -10,7 +10,7 @@
 #include <string>
 
 #include "data_store.h"
-#include "mesh.h"
+#include "mesh/mesh.h"
 #include "server_config.h"
 
 namespace solidtex::server {

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <cstdlib>
 
-#include "number_list.h"
+#include "core/number_list.h"
 
 namespace solidtex::server {
 

@@ -7,8 +7,8 @@
 #include <chrono>
 #include <memory>
 
-#include "interrupter.h"
-#include "status.h"
+#include "core/interrupter.h"
+#include "core/status.h"
 
 namespace solidtex::server {
 

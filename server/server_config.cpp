@@ -1,6 +1,6 @@
 #include "server_config.h"
 
-#include "target.h"
+#include "synthesis/target.h"
 
 namespace solidtex::server {
 namespace {

@@ -5,9 +5,9 @@
 #include <cstdint>
 #include <string>
 
-#include "image_io.h"
-#include "mesh.h"
-#include "status.h"
+#include "core/image_io.h"
+#include "mesh/mesh.h"
+#include "core/status.h"
 
 namespace solidtex::server {
 

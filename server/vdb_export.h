@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "status.h"
-#include "types.h"
+#include "core/status.h"
+#include "core/types.h"
 
 namespace solidtex::server {
 

@@ -7,10 +7,10 @@
 #include <mutex>
 
 #include "api_json.h"
-#include "field_file.h"
-#include "json_fields.h"
-#include "region_volume.h"
-#include "synthesizer.h"
+#include "field/field_file.h"
+#include "core/json_fields.h"
+#include "synthesis/region_volume.h"
+#include "synthesis/synthesizer.h"
 
 namespace solidtex::server {
 

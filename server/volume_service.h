@@ -22,9 +22,9 @@
 #include "exemplar_service.h"
 #include "field_service.h"
 #include "mesh_service.h"
-#include "interrupter.h"
+#include "core/interrupter.h"
 #include "server_config.h"
-#include "target.h"
+#include "synthesis/target.h"
 
 namespace solidtex::server {
 

@@ -1,0 +1,106 @@
+#include "analysis/analysis.h"
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <mutex>
+
+#include "analysis/gaussian_stack.h"
+#include "analysis/neighborhood.h"
+
+namespace solidtex {
+namespace {
+
+// Fits a PCA on N x N neighbourhoods sampled on a fixed lattice (at most ~4096 of them).
+Result<PcaBasis> fit_level_pca(const ImageF& stack, int n, int spacing, int out_dims) {
+  const int64_t pixels = stack.pixel_count();
+  const int stride = std::max(1, int(std::ceil(std::sqrt(double(pixels) / 4096.0))));
+  const int dims = neighborhood_dims(n, stack.channels);
+  std::vector<float> samples;
+  int count = 0;
+  for (int y = 0; y < stack.height; y += stride)
+    for (int x = 0; x < stack.width; x += stride) {
+      samples.resize(size_t(count + 1) * dims);
+      gather_neighborhood(stack, {x, y}, n, spacing, &samples[size_t(count) * dims]);
+      ++count;
+    }
+  return fit_pca(samples, count, dims, out_dims);
+}
+
+// Serialises progress from worker threads into the interrupter.
+class ProgressSink {
+ public:
+  explicit ProgressSink(Interrupter& i) : interrupter_(i) {}
+  bool report(double fraction) {
+    std::lock_guard<std::mutex> g(mutex_);
+    int pct = std::clamp(int(fraction * 100.0), 0, 100);
+    if (interrupter_.was_interrupted(pct)) cancelled_ = true;
+    return cancelled_;
+  }
+  bool cancelled() const { return cancelled_; }
+
+ private:
+  Interrupter& interrupter_;
+  std::mutex mutex_;
+  bool cancelled_ = false;
+};
+
+}  // namespace
+
+std::vector<LevelReport> level_reports(const Table& table) {
+  std::vector<LevelReport> out;
+  for (int l = 0; l < table.levels(); ++l) {
+    const auto& c = table.level(PyramidLevel{l}).candidates;
+    out.push_back({l, table.spacing(PyramidLevel{l}), c.mean_crossbar_error, c.random_crossbar_error, c.coherent_fraction});
+  }
+  return out;
+}
+
+Result<AnalysisResult> analyze(const ExemplarSet& exemplars, const AnalysisParams& params, Interrupter& interrupter) {
+  SOLIDTEX_RETURN_IF_ERROR(params.validate());
+  const auto t0 = std::chrono::steady_clock::now();
+  interrupter.start("analyze");
+  ProgressSink sink(interrupter);
+  const int L = params.levels;
+  const int n = params.neighborhood;
+  const int distinct = exemplars.shared() ? 1 : 3;
+
+  // Stacks of each distinct image, indexed by stack index (0 = original).
+  std::array<std::vector<ImageF>, 3> stacks;
+  for (int k = 0; k < distinct; ++k) stacks[k] = build_gaussian_stack(exemplars.plane(plane_from_index(k)), L);
+
+  std::vector<std::array<PcaBasis, 3>> pcas(static_cast<size_t>(L));
+  std::vector<LevelCandidates> candidates(static_cast<size_t>(L));
+  // Work share per level grows with its... every level costs about the same: split evenly.
+  for (int l = 0; l < L; ++l) {
+    const int spacing = stack_spacing(PyramidLevel{l}, L);
+    const int s = L - 1 - l;
+    PlaneStacks level_stacks{};
+    for (int k = 0; k < 3; ++k) level_stacks[k] = &stacks[exemplars.shared() ? 0 : k][size_t(s)];
+    for (int k = 0; k < distinct; ++k) {
+      SOLIDTEX_ASSIGN_OR_RETURN(pcas[l][k], fit_level_pca(*level_stacks[k], n, spacing, params.pca_dims));
+    }
+    if (distinct == 1) pcas[l][1] = pcas[l][2] = pcas[l][0];
+
+    CandidateParams cp;
+    cp.neighborhood = n;
+    cp.candidates = params.candidates;
+    cp.search_k = params.search_k;
+    cp.knn.checks = params.knn_checks;
+    cp.knn.seed = params.seed;
+    auto progress = [&](double f) { return sink.report((double(l) + f * 0.9) / double(L)); };
+    SOLIDTEX_ASSIGN_OR_RETURN(candidates[l], compute_level_candidates(level_stacks, exemplars.shared(), spacing, cp,
+                                                                      params.seed, progress));
+    measure_level_candidates(level_stacks, n, spacing, params.seed, candidates[l]);
+    if (sink.report(double(l + 1) / double(L))) return Status(StatusCode::kCancelled, "analysis cancelled");
+  }
+  SOLIDTEX_ASSIGN_OR_RETURN(auto table, Table::assemble(params, exemplars, std::move(pcas), std::move(candidates)));
+  interrupter.end();
+  AnalysisResult result;
+  result.table = table;
+  result.levels = level_reports(*table);
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return result;
+}
+
+}  // namespace solidtex

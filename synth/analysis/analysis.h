@@ -1,0 +1,36 @@
+// Exemplar analysis: Gaussian stacks, PCA appearance spaces and candidate triples per level.
+// Deterministic: identical inputs and parameters give identical tables, bit for bit, whatever
+// the thread count (tests/analysis_test.cpp checks this through the encoded .stx bytes).
+// Long-running; honours the interrupter (progress in percent, cancellation).
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "analysis/analysis_params.h"
+#include "analysis/exemplar.h"
+#include "core/interrupter.h"
+#include "analysis/table.h"
+
+namespace solidtex {
+
+struct LevelReport {
+  int level = 0;                     // 0 = coarsest
+  int spacing = 1;                   // exemplar pixels between samples, h
+  double mean_crossbar_error = 0;    // stored candidates
+  double random_crossbar_error = 0;  // uniformly random triples
+  double coherent_fraction = 0;      // stored candidates coherent with a neighbour
+};
+
+struct AnalysisResult {
+  std::shared_ptr<const Table> table;
+  std::vector<LevelReport> levels;
+  double seconds = 0;
+};
+
+Result<AnalysisResult> analyze(const ExemplarSet& exemplars, const AnalysisParams& params,
+                               Interrupter& interrupter = null_interrupter());
+
+std::vector<LevelReport> level_reports(const Table& table);
+
+}  // namespace solidtex

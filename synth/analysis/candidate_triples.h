@@ -1,0 +1,79 @@
+// Candidate coordinate triples of one pyramid level (Zhang §2; Dong et al. 2008).
+//
+// For every pixel p of every plane's exemplar we keep up to N_T triples T with T[plane] = p
+// whose three N x N neighbourhoods agree along their pairwise crossbars. Plane k's second
+// axis is plane k+1's first axis (types.h), so the three crossbars of T are
+//   second-axis line of plane k at T[k]  vs  first-axis line of plane k+1 at T[k+1],  k = 0,1,2,
+// each N samples at the level's spacing h. Search: the k-NN (FLANN) of p's second-axis line among
+// plane k+1's first-axis lines, and of p's first-axis line among plane k+2's second-axis lines;
+// every pair (q, r) of those neighbours forms a triple, scored by the sum of all three crossbar
+// squared differences. Of the best 2*N_T, triples that are *spatially coherent* with a
+// neighbouring pixel (the neighbour at p + h*delta holds T shifted by the same 3D step, Eq. 4)
+// are kept first, then the rest by error; the stored list is sorted by error, best first.
+//
+// When one image serves all three planes the problem is symmetric under cyclic rotation of the
+// planes, so only plane xy is searched and planes yz, zx are its rotations (exactly equal to
+// searching them). Deterministic: fixed seeds, per-pixel work written to fixed slots.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <vector>
+
+#include "core/image.h"
+#include "core/interrupter.h"
+#include "analysis/knn_index.h"
+#include "core/status.h"
+#include "core/types.h"
+
+namespace solidtex {
+
+struct CandidateParams {
+  int neighborhood = 9;   // N, odd, exemplar pixels per crossbar (at the level's spacing)
+  int candidates = 12;    // N_T, triples kept per pixel, [1, 64]
+  int search_k = 24;      // nearest crossbar lines kept per search; pairs = search_k^2
+  KnnParams knn;
+};
+
+// Triples of one plane at one level; slot (y*width + x)*per_pixel + i.
+struct PlaneCandidates {
+  int width = 0;
+  int height = 0;
+  int per_pixel = 0;
+  std::vector<CoordinateTriple> triples;
+  std::vector<uint8_t> counts;  // valid triples per pixel, <= per_pixel
+
+  std::span<const CoordinateTriple> at(ExemplarPixel p) const {
+    const size_t i = size_t(ImageF::wrap(p.y, height)) * width + ImageF::wrap(p.x, width);
+    return {triples.data() + i * per_pixel, counts[i]};
+  }
+  friend bool operator==(const PlaneCandidates&, const PlaneCandidates&) = default;
+};
+
+struct LevelCandidates {
+  std::array<PlaneCandidates, 3> planes;
+  double mean_crossbar_error = 0;    // mean over stored triples (per sample and channel)
+  double random_crossbar_error = 0;  // the same measure over uniformly random triples
+  double coherent_fraction = 0;      // stored triples coherent with a neighbouring pixel
+};
+
+using PlaneStacks = std::array<const ImageF*, 3>;  // one matching image per plane, same channels
+
+// Mean squared difference per crossbar sample and channel.
+double crossbar_error(const PlaneStacks& stacks, const CoordinateTriple& t, int n, int spacing);
+
+// Maps plane-xy candidates of a shared exemplar to plane `k`: out[j] = t[j - k].
+CoordinateTriple rotate_planes(const CoordinateTriple& t, int k);
+
+// `progress(done_fraction)` is called from worker threads; returning true cancels.
+Result<LevelCandidates> compute_level_candidates(const PlaneStacks& stacks, bool shared, int spacing,
+                                                 const CandidateParams& params, uint32_t seed,
+                                                 const std::function<bool(double)>& progress);
+
+// Fills mean/random error and coherent fraction of `level` (used after loading a table, too).
+void measure_level_candidates(const PlaneStacks& stacks, int n, int spacing, uint32_t seed,
+                              LevelCandidates& level);
+
+}  // namespace solidtex

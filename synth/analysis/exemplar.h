@@ -1,0 +1,57 @@
+// The exemplar images synthesis matches against: one per sectional plane (xy, yz, zx), or a
+// single image shared by all three. Each plane's *matching image* is its linear RGB plus, when
+// a feature mask is given (Zhang §4: high intensity marks feature curves), one more channel
+// holding mask luminance times `mask_weight`. All planes have the same channel count.
+// Immutable after construction; safe to share between threads.
+#pragma once
+
+#include <array>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "core/image.h"
+#include "core/status.h"
+#include "core/types.h"
+
+namespace solidtex {
+
+inline constexpr int kMinExemplarSide = 8;
+
+struct ExemplarInputs {
+  ImageF xy;                          // required; linear RGB
+  std::optional<ImageF> yz, zx;       // both or neither; absent means "use xy for every plane"
+  std::optional<ImageF> mask_xy;      // feature masks, same size as their exemplar
+  std::optional<ImageF> mask_yz, mask_zx;  // required with yz/zx when mask_xy is given
+  float mask_weight = 1.0f;           // scale of the mask channel relative to colour, [0, 10]
+};
+
+// Grain layouts (shared by `solidtex analyze --grain` and the service's `grain` parameter).
+// "x": an anisotropic exemplar whose stripes run along its x axis, for a solid whose grain
+// runs along world x: xy = E, zx = E transposed (consistent in 3D), yz = E (the end grain
+// the exemplar cannot show, so the returned suggested plane weights give it 0.1).
+// Fails when the inputs already have yz/zx. "" leaves everything unchanged.
+Status apply_grain_layout(const std::string& grain, ExemplarInputs& inputs,
+                          std::array<float, 3>& suggested_plane_weights);
+
+class ExemplarSet {
+ public:
+  // Validates sizes and mask consistency; errors name the offending input.
+  static Result<ExemplarSet> create(ExemplarInputs inputs);
+  // Rebuilds a set from stored matching images (table files); `shared` if one image serves all.
+  static Result<ExemplarSet> from_matching_images(std::array<std::shared_ptr<const ImageF>, 3> planes,
+                                                  bool has_mask);
+
+  const ImageF& plane(Plane p) const { return *planes_[index_of(p)]; }
+  const std::shared_ptr<const ImageF>& plane_ptr(Plane p) const { return planes_[index_of(p)]; }
+  // True when one image is used for all three planes (then analysis exploits the symmetry).
+  bool shared() const { return planes_[0] == planes_[1] && planes_[1] == planes_[2]; }
+  bool has_mask() const { return has_mask_; }
+  int channels() const { return planes_[0]->channels; }  // 3 or 4 (with mask)
+
+ private:
+  std::array<std::shared_ptr<const ImageF>, 3> planes_;
+  bool has_mask_ = false;
+};
+
+}  // namespace solidtex

@@ -1,0 +1,26 @@
+// Principal component analysis of neighbourhood vectors, to match in a small appearance
+// space (Zhang §4.3: about 20 dimensions per plane). Deterministic: samples are taken on a
+// fixed pixel lattice, eigenvectors are sign-normalised (largest |component| positive).
+#pragma once
+
+#include <vector>
+
+#include "core/status.h"
+
+namespace solidtex {
+
+struct PcaBasis {
+  int input_dims = 0;
+  int output_dims = 0;
+  std::vector<float> mean;   // input_dims
+  std::vector<float> basis;  // output_dims rows of input_dims, most significant first
+
+  // out[r] = basis_r . (in - mean); fixed summation order.
+  void project(const float* in, float* out) const;
+  friend bool operator==(const PcaBasis&, const PcaBasis&) = default;
+};
+
+// `samples` holds `count` vectors of `dims` floats. output_dims is clamped to dims.
+Result<PcaBasis> fit_pca(const std::vector<float>& samples, int count, int dims, int output_dims);
+
+}  // namespace solidtex

@@ -1,0 +1,63 @@
+// The candidate-triple table of one exemplar set: everything synthesis needs, built by
+// analyze() (analysis.h) or loaded from a .stx file (table_file.h).
+//
+// Stored (in .stx): parameters, the matching images, per level and distinct image the PCA
+// basis, per level and plane the candidate triples, and per level the analysis statistics.
+// Derived on construction (not stored, reproduced bit for bit): Gaussian stacks and every
+// pixel's projected neighbourhood ("appearance vector").
+// Immutable once built; safe to share between threads.
+#pragma once
+
+#include <array>
+#include <memory>
+#include <vector>
+
+#include "analysis/analysis_params.h"
+#include "analysis/candidate_triples.h"
+#include "analysis/exemplar.h"
+#include "core/image.h"
+#include "analysis/pca.h"
+#include "core/types.h"
+
+namespace solidtex {
+
+// One distinct exemplar image at one pyramid level.
+struct PlaneAppearance {
+  ImageF stack;                   // Gaussian-stack matching image at this level's blur
+  PcaBasis pca;                   // fitted on N x N neighbourhoods at this level's spacing
+  std::vector<float> projected;   // width*height rows of pca.output_dims: appearance vectors
+
+  const float* appearance(ExemplarPixel p) const {
+    const size_t i = size_t(ImageF::wrap(p.y, stack.height)) * stack.width + ImageF::wrap(p.x, stack.width);
+    return &projected[i * pca.output_dims];
+  }
+};
+
+struct TableLevel {
+  std::array<std::shared_ptr<const PlaneAppearance>, 3> planes;  // same pointer when shared
+  LevelCandidates candidates;
+};
+
+class Table {
+ public:
+  // Builds derived data (stacks, projections) from stored parts; used by analysis and loading.
+  static Result<std::shared_ptr<const Table>> assemble(AnalysisParams params, ExemplarSet exemplars,
+                                                       std::vector<std::array<PcaBasis, 3>> pca_per_level,
+                                                       std::vector<LevelCandidates> candidates);
+
+  const AnalysisParams& params() const { return params_; }
+  const ExemplarSet& exemplars() const { return exemplars_; }
+  int levels() const { return int(levels_.size()); }
+  const TableLevel& level(PyramidLevel l) const { return levels_[size_t(l.index)]; }
+  int spacing(PyramidLevel l) const { return stack_spacing(l, levels()); }
+
+ private:
+  AnalysisParams params_;
+  ExemplarSet exemplars_;
+  std::vector<TableLevel> levels_;
+};
+
+// Projects every pixel's N x N neighbourhood of `stack` at `spacing` through `pca`.
+std::vector<float> project_all_neighborhoods(const ImageF& stack, const PcaBasis& pca, int n, int spacing);
+
+}  // namespace solidtex

@@ -1,0 +1,27 @@
+#include "core/image.h"
+
+#include <cmath>
+
+namespace solidtex {
+
+ImageF transposed(const ImageF& in) {
+  ImageF out(in.height, in.width, in.channels);
+  for (int y = 0; y < in.height; ++y)
+    for (int x = 0; x < in.width; ++x)
+      for (int c = 0; c < in.channels; ++c) out.at(y, x)[c] = in.at(x, y)[c];
+  return out;
+}
+
+float srgb_to_linear(float v) {
+  if (v <= 0.04045f) return v / 12.92f;
+  return std::pow((v + 0.055f) / 1.055f, 2.4f);
+}
+
+float linear_to_srgb(float v) {
+  if (v <= 0.f) return 0.f;
+  if (v >= 1.f) return 1.f;
+  if (v <= 0.0031308f) return v * 12.92f;
+  return 1.055f * std::pow(v, 1.f / 2.4f) - 0.055f;
+}
+
+}  // namespace solidtex

@@ -1,0 +1,32 @@
+// Unsigned distance from world points to a placed mesh's surface, for "within distance d of the
+// surface" region labels (Zhang Fig. 15: bark near the surface, wood inside). Built once with
+// OpenVDB's mesh-to-volume conversion as a narrow band of `band` voxels around the surface (one
+// voxel = one world unit); farther points report a distance above `band`. Immutable and
+// thread-safe; deterministic for the same mesh and placement. Only mesh_distance.cpp includes
+// OpenVDB.
+#pragma once
+
+#include <memory>
+
+#include "mesh/mesh.h"
+#include "core/status.h"
+#include "core/types.h"
+
+namespace solidtex {
+
+class SurfaceDistance {
+ public:
+  static Result<std::shared_ptr<const SurfaceDistance>> create(const Mesh& mesh, const Placement& placement, double band);
+  ~SurfaceDistance();
+  // Distance in world units from p to the surface; > band() when farther than the band.
+  double at(const WorldPoint& p) const;
+  double band() const { return band_; }
+
+ private:
+  SurfaceDistance() = default;
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  double band_ = 0;
+};
+
+}  // namespace solidtex

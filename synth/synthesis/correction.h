@@ -1,0 +1,124 @@
+// Tensor-aligned correction of one voxel (Zhang §4.3), and the read stencil it uses.
+//
+// The stencil is the single source of truth for what a correction reads: the correction
+// kernel gathers exactly its taps and candidate offsets, and the dependency analysis marks
+// exactly the same offsets. Both call build_stencil() with the same rotation, so reads and
+// dependency sets agree bit for bit (checked by the instrumented synthesis test).
+//
+// Neighbourhoods: for plane k with exemplar axes (first, second) and offsets i, j in
+// [-N/2, N/2], the local offset has `i` on the plane's first axis and `j` on its second
+// (xy: (i,j,0), yz: (0,i,j), zx: (j,0,i)); the world sample is p + R * local, in voxels of
+// the level. Trilinear levels blend the 8 surrounding voxels (corners of weight exactly 0 are
+// not read); the others take the nearest voxel (std::lround on each axis).
+//
+// Candidate set S(v): the voxel's current triple, plus for every plane k and in-plane step
+// (a, b) in {-1,0,1}^2 the N_T table candidates of plane k at T_k(u) - h*(a, b), where
+// u = p + lround(R * local(a, b)) (the reduced d-set of §4.3). Matching: each plane's gathered
+// N x N x C vector is projected by that plane's PCA basis; a candidate's cost is the sum over
+// planes of squared distances to its stored appearance vectors. Lowest cost wins; equal costs
+// go to the lexicographically smallest triple. No randomness, fixed summation order.
+//
+// Voxel colour: the matching colour of a triple is the mean over the three planes of that
+// level's Gaussian-stack colour at T_k (RGB plus mask channel), weighted by the plane weights;
+// the output colour of a finest-level voxel is the same mean over the original exemplars' RGB.
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "field/frame_field.h"
+#include "analysis/table.h"
+#include "core/types.h"
+
+namespace solidtex {
+
+struct VoxelState {
+  CoordinateTriple triple;
+  std::array<float, 4> colour{};  // matching colour; channels beyond the table's are 0
+};
+
+struct Tap {
+  int8_t dx, dy, dz;
+  float weight;
+};
+
+struct ReadStencil {
+  int n = 0;
+  bool trilinear = false;
+  std::vector<Tap> taps;            // taps of every sample, sample after sample
+  std::vector<uint16_t> begin;      // 3*n*n + 1 offsets into taps
+  std::array<std::array<std::array<int8_t, 3>, 9>, 3> candidate{};  // [plane][(b+1)*3+(a+1)]
+};
+
+void build_stencil(const Rot3& r, int n, bool trilinear, ReadStencil& out);
+
+// Every distinct voxel offset the stencil reads, in a fixed order.
+void stencil_offsets(const ReadStencil& s, std::vector<std::array<int8_t, 3>>& out);
+
+// Colours are weighted means over the planes (weights normalised to sum to 1).
+using PlaneWeights = std::array<float, 3>;
+PlaneWeights normalised_weights(const std::array<float, 3>& w);
+void matching_colour(const TableLevel& level, const CoordinateTriple& t, int channels, const PlaneWeights& w, float* out);
+void output_colour(const Table& table, const CoordinateTriple& t, const PlaneWeights& w, float rgb[3]);
+
+// Per-level constants of the correction, precomputed once per synthesizer.
+struct CorrectionContext {
+  const TableLevel* level = nullptr;
+  int n = 0;
+  int spacing = 1;
+  int channels = 3;
+  int dims = 0;                                      // PCA output dims per plane
+  std::array<std::vector<float>, 3> basis_t;         // input-major PCA bases
+  std::array<const float*, 3> mean{};
+  PlaneWeights cost_weights{1.f, 1.f, 1.f};          // per-plane matching weights
+  int candidates_per_source = 64;                    // table candidates tried per source pixel
+  PlaneWeights colour_weights{1.f / 3, 1.f / 3, 1.f / 3};
+  static CorrectionContext make(const Table& table, PyramidLevel l, const std::array<float, 3>& plane_weights,
+                                bool coherent_matcher);
+};
+
+struct CorrectionScratch {
+  std::vector<float> gathered;    // 3 * n*n*channels
+  std::vector<float> projected;   // 3 * dims
+};
+
+namespace detail {
+void project_planes(const CorrectionContext& ctx, CorrectionScratch& s);
+CoordinateTriple best_candidate(const CorrectionContext& ctx, const CoordinateTriple& current,
+                                const std::array<std::array<ExemplarPixel, 9>, 3>& sources, CorrectionScratch& s);
+}  // namespace detail
+
+// Corrects one voxel. `read(dx, dy, dz)` returns the neighbour's state at the version the
+// history window names for that offset.
+template <class Reader>
+CoordinateTriple correct_voxel(const CorrectionContext& ctx, const ReadStencil& st, Reader& read, CorrectionScratch& s) {
+  const int c = ctx.channels;
+  const int nn = ctx.n * ctx.n;
+  s.gathered.resize(size_t(3) * nn * c);
+  float* g = s.gathered.data();
+  const int samples = 3 * nn;
+  for (int q = 0; q < samples; ++q) {
+    float acc[4] = {0, 0, 0, 0};
+    for (int t = st.begin[q]; t < st.begin[q + 1]; ++t) {
+      const Tap& tap = st.taps[size_t(t)];
+      const VoxelState& v = read(tap.dx, tap.dy, tap.dz);
+      for (int k = 0; k < c; ++k) acc[k] += tap.weight * v.colour[size_t(k)];
+    }
+    for (int k = 0; k < c; ++k) *g++ = acc[k];
+  }
+  detail::project_planes(ctx, s);
+  const CoordinateTriple current = read(0, 0, 0).triple;
+  std::array<std::array<ExemplarPixel, 9>, 3> sources;
+  for (int plane = 0; plane < 3; ++plane)
+    for (int ab = 0; ab < 9; ++ab) {
+      const auto& o = st.candidate[size_t(plane)][size_t(ab)];
+      const ExemplarPixel t = read(o[0], o[1], o[2]).triple.at[size_t(plane)];
+      const int a = ab % 3 - 1, b = ab / 3 - 1;
+      sources[size_t(plane)][size_t(ab)] = {t.x - ctx.spacing * a, t.y - ctx.spacing * b};
+    }
+  return detail::best_candidate(ctx, current, sources, s);
+}
+
+}  // namespace solidtex

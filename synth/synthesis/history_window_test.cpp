@@ -1,0 +1,68 @@
+#include "synthesis/history_window.h"
+
+#include <gtest/gtest.h>
+
+namespace solidtex {
+namespace {
+
+TEST(HistoryWindow, LatestReadsThePreviousVersionEverywhere) {
+  const auto w = HistoryWindow::latest(5).materialize({3, 4, 5}, 13);
+  ASSERT_EQ(w.size(), 13u * 13u * 13u);
+  for (int v : w) EXPECT_EQ(v, 4);
+}
+
+TEST(HistoryWindow, GridBarrierReadsBarrierVersionOutsideTheCell) {
+  const CellLattice cells{12, 0};
+  const auto w = HistoryWindow::grid(7, cells, 0);
+  const Voxel p{11, 0, 5};  // on the +x face of cell [0, 12)
+  EXPECT_EQ(w.version(p, 0, 0, 0), 6);
+  EXPECT_EQ(w.version(p, -5, 3, 2), 6);
+  EXPECT_EQ(w.version(p, 1, 0, 0), 0);   // crosses into the next cell
+  EXPECT_EQ(w.version(p, 0, -1, 0), 0);  // y = -1 is in another cell
+  const CellLattice dual{12, 6};
+  const auto d = HistoryWindow::grid(7, dual, 3);
+  EXPECT_EQ(d.version(p, 1, 5, 0), 6);   // dual cells: x [6, 18), y and z [-6, 6)
+  EXPECT_EQ(d.version({11, 6, 5}, 1, -1, 0), 3);
+}
+
+TEST(HistoryWindow, IntersectionIsTheElementwiseMinimum) {
+  const auto a = HistoryWindow::grid(9, {8, 0}, 2);
+  const auto b = HistoryWindow::grid(9, {8, 4}, 5);
+  const auto c = a.intersect(b);
+  const Voxel p{6, 1, 3};
+  const auto wa = a.materialize(p, 13), wb = b.materialize(p, 13), wc = c.materialize(p, 13);
+  bool saw_each = false;
+  for (size_t i = 0; i < wc.size(); ++i) {
+    EXPECT_EQ(wc[i], std::min(wa[i], wb[i]));
+    saw_each |= wa[i] != wb[i];
+  }
+  EXPECT_TRUE(saw_each);
+}
+
+TEST(LevelSchedule, DualGridStepsSlotsAndBarriers) {
+  SynthesisParams p;  // dual-grid, 2 passes, 8 subpasses
+  const LevelSchedule fine = LevelSchedule::make(1, p);
+  ASSERT_EQ(fine.final_version(), 16);
+  EXPECT_EQ(fine.slot_count(), 3);
+  // Class 0 updates at versions 1 and 9; class 7 at 8 and 16.
+  EXPECT_EQ(fine.slot({0, 0, 0}, 0), 0);
+  EXPECT_EQ(fine.slot({0, 0, 0}, 1), 1);
+  EXPECT_EQ(fine.slot({0, 0, 0}, 8), 1);
+  EXPECT_EQ(fine.slot({0, 0, 0}, 9), 2);
+  EXPECT_EQ(fine.slot({1, 1, 1}, 7), 0);
+  EXPECT_EQ(fine.slot({1, 1, 1}, 8), 1);
+  EXPECT_EQ(fine.slot({1, 1, 1}, 16), 2);
+  // Primary pass: barrier 0 across cells; dual pass: barrier = end of the grid pass (8).
+  const Voxel edge{11, 11, 11};
+  EXPECT_EQ(fine.steps()[3].window.version(edge, 1, 0, 0), 0);
+  EXPECT_EQ(fine.steps()[12].window.version(edge, 1, 0, 0), 12);   // same dual cell [6, 18)
+  EXPECT_EQ(fine.steps()[12].window.version({17, 6, 6}, 1, 0, 0), 8);
+  const LevelSchedule coarse = LevelSchedule::make(0, p);
+  EXPECT_EQ(coarse.final_version(), 3);
+  for (const auto& s : coarse.steps()) EXPECT_FALSE(s.window.has_barrier());
+  p.scheme = Scheme::kStandard;
+  EXPECT_EQ(LevelSchedule::make(2, p).final_version(), 2);
+}
+
+}  // namespace
+}  // namespace solidtex

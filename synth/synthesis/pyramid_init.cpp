@@ -1,0 +1,69 @@
+#include "synthesis/pyramid_init.h"
+
+#include <cmath>
+
+#include "core/hash.h"
+#include "synthesis/voxel_mask.h"
+
+namespace solidtex {
+namespace {
+constexpr int kFirstAxis[3] = {0, 1, 2};
+constexpr int kSecondAxis[3] = {1, 2, 0};
+}  // namespace
+
+WorldPoint voxel_centre(PyramidLevel level, int levels, const Voxel& v) {
+  const double s = double(stack_spacing(level, levels));
+  return {(v.x + 0.5) * s - 0.5, (v.y + 0.5) * s - 0.5, (v.z + 0.5) * s - 0.5};
+}
+
+CoordinateTriple shift_triple(const Table& table, const CoordinateTriple& t, const int step[3]) {
+  CoordinateTriple out = t;
+  for (int k = 0; k < 3; ++k) {
+    const ImageF& img = table.exemplars().plane(plane_from_index(k));
+    out.at[size_t(k)].x = ImageF::wrap(t.at[size_t(k)].x + step[kFirstAxis[k]], img.width);
+    out.at[size_t(k)].y = ImageF::wrap(t.at[size_t(k)].y + step[kSecondAxis[k]], img.height);
+  }
+  return out;
+}
+
+CoordinateTriple init_triple(const Table& table, const Voxel& v, const Rot3& r, const SynthesisParams& params) {
+  const PyramidLevel coarsest{0};
+  const int h = table.spacing(coarsest);
+  const int n = table.params().neighborhood;
+  const int k = params.init_subpart;
+  const int sx = floor_div(v.x, k), sy = floor_div(v.y, k), sz = floor_div(v.z, k);
+  const int cx = sx * k + k / 2, cy = sy * k + k / 2, cz = sz * k + k / 2;
+  const float rel[3] = {float(v.x - cx), float(v.y - cy), float(v.z - cz)};
+  float local[3];
+  r.apply_inverse(rel, local);
+  const int wx = int(std::lround(local[0])) + cx, wy = int(std::lround(local[1])) + cy, wz = int(std::lround(local[2])) + cz;
+  const int layer = floor_div(wz, n);
+  const int dz = wz - layer * n - n / 2;
+  const ImageF& xy = table.exemplars().plane(Plane::kXY);
+  const uint64_t hsh = hash_u64(uint64_t(int64_t(layer)), uint64_t(int64_t(sx)) * 73856093ull ^ uint64_t(int64_t(sy)) * 19349663ull ^
+                                    uint64_t(int64_t(sz)) * 83492791ull,
+                                params.seed, 0x51ab);
+  const int ox = int(hsh % uint64_t(xy.width)), oy = int((hsh >> 32) % uint64_t(xy.height));
+  const ExemplarPixel pixel{ImageF::wrap(h * wx + ox, xy.width), ImageF::wrap(h * wy + oy, xy.height)};
+  const auto list = table.level(coarsest).candidates.planes[0].at(pixel);
+  CoordinateTriple base;
+  if (list.empty()) {
+    base.at = {pixel, pixel, pixel};
+  } else {
+    base = list[0];
+  }
+  const int step[3] = {0, 0, h * dz};
+  return shift_triple(table, base, step);
+}
+
+CoordinateTriple upsample_triple(const Table& table, PyramidLevel child_level, const Voxel& v,
+                                 const CoordinateTriple& parent, const Rot3& parent_rotation) {
+  const float h = float(table.spacing(child_level));
+  const float t[3] = {h * float(v.x & 1), h * float(v.y & 1), h * float(v.z & 1)};
+  float local[3];
+  parent_rotation.apply_inverse(t, local);
+  const int step[3] = {int(std::lround(local[0])), int(std::lround(local[1])), int(std::lround(local[2]))};
+  return shift_triple(table, parent, step);
+}
+
+}  // namespace solidtex

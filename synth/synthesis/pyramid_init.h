@@ -1,0 +1,31 @@
+// Version 0 of every level: initialisation at the coarsest level (§4.1) and upsampling from
+// the parent (§4.2, Eq. 3-4). Pure functions of (table, rotation, voxel, params).
+//
+// Initialisation: the volume is tiled with candidate slabs. A slab is exemplar xy thickened
+// by N voxels along z: voxel w of layer L = floor(w.z / N) takes the first candidate triple of
+// pixel (h*w.x + ox, h*w.y + oy), moved by the 3D step (0, 0, h*(w.z - L*N - N/2)) (Eq. 4);
+// (ox, oy) is hash(layer, subpart, seed) so layers and subparts differ. The coarsest level is
+// cut into K^3 subparts; a voxel v in the subpart with centre c reads the tiled volume at
+// w = lround(R^T (v - c)) + c, so the slab pattern turns with the local frame about c and
+// rotation-induced distortion stays bounded by K (Fig. 4).
+//
+// Upsampling: child v of parent P = floor(v/2) gets T(P) + R_P^T * (h_l * (v mod 2)), each
+// plane's 2D offset rounded to the nearest pixel (std::lround).
+#pragma once
+
+#include "field/frame_field.h"
+#include "synthesis/synthesis_params.h"
+#include "analysis/table.h"
+#include "core/types.h"
+
+namespace solidtex {
+
+CoordinateTriple init_triple(const Table& table, const Voxel& v, const Rot3& r, const SynthesisParams& params);
+CoordinateTriple upsample_triple(const Table& table, PyramidLevel child_level, const Voxel& v,
+                                 const CoordinateTriple& parent, const Rot3& parent_rotation);
+// World-space centre of voxel v at `level` (one world unit = one finest voxel).
+WorldPoint voxel_centre(PyramidLevel level, int levels, const Voxel& v);
+// Moves a triple by a 3D exemplar-pixel step (Eq. 4) and wraps into the exemplars.
+CoordinateTriple shift_triple(const Table& table, const CoordinateTriple& t, const int step[3]);
+
+}  // namespace solidtex

@@ -1,0 +1,55 @@
+#include "synthesis/synthesis_params.h"
+
+namespace solidtex {
+
+Result<Scheme> parse_scheme(const std::string& name) {
+  if (name == "standard") return Scheme::kStandard;
+  if (name == "subpass") return Scheme::kSubpass;
+  if (name == "grid") return Scheme::kGrid;
+  if (name == "dual-grid") return Scheme::kDualGrid;
+  return Status(StatusCode::kInvalidArgument, "unknown scheme '" + name + "' (standard, subpass, grid, dual-grid)", "scheme");
+}
+
+Result<Matcher> parse_matcher(const std::string& name) {
+  if (name == "paper") return Matcher::kPaper;
+  if (name == "coherent") return Matcher::kCoherent;
+  return Status(StatusCode::kInvalidArgument, "unknown matcher '" + name + "' (paper, coherent)", "matcher");
+}
+
+const char* matcher_name(Matcher m) { return m == Matcher::kPaper ? "paper" : "coherent"; }
+
+const char* scheme_name(Scheme s) {
+  switch (s) {
+    case Scheme::kStandard: return "standard";
+    case Scheme::kSubpass: return "subpass";
+    case Scheme::kGrid: return "grid";
+    case Scheme::kDualGrid: return "dual-grid";
+  }
+  return "?";
+}
+
+Status SynthesisParams::validate() const {
+  auto range = [](int v, int lo, int hi, const char* f) {
+    return v < lo || v > hi ? Status(StatusCode::kInvalidArgument,
+                                     "is " + std::to_string(v) + "; must be in [" + std::to_string(lo) + ", " +
+                                         std::to_string(hi) + "]",
+                                     f)
+                            : Status::ok();
+  };
+  SOLIDTEX_RETURN_IF_ERROR(range(coarse_passes, 0, 8, "coarse_passes"));
+  SOLIDTEX_RETURN_IF_ERROR(range(passes, 0, 8, "passes"));
+  SOLIDTEX_RETURN_IF_ERROR(range(subpass_size, 1, 2, "subpass_size"));
+  SOLIDTEX_RETURN_IF_ERROR(range(cell_size, 4, 64, "cell_size"));
+  SOLIDTEX_RETURN_IF_ERROR(range(init_subpart, 8, 256, "init_subpart"));
+  if (init_subpart % 2) return Status(StatusCode::kInvalidArgument, "must be even", "init_subpart");
+  SOLIDTEX_RETURN_IF_ERROR(range(trilinear_levels, 0, 8, "trilinear_levels"));
+  float total = 0.f;
+  for (float w : plane_weights) {
+    if (!(w >= 0.f && w <= 1.f)) return Status(StatusCode::kInvalidArgument, "each must be in [0, 1]", "plane_weights");
+    total += w;
+  }
+  if (!(total > 0.f)) return Status(StatusCode::kInvalidArgument, "must not all be zero", "plane_weights");
+  return Status::ok();
+}
+
+}  // namespace solidtex

@@ -1,0 +1,50 @@
+// Parameters of solid synthesis: a plain struct validated once; errors name the field.
+// Defaults follow Zhang et al. §6: 3 unbarriered passes at the coarsest level, then at every
+// finer level 2 passes of dual-grid correction (cell M = 12) with s^3 = 8 subpasses.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+
+#include "core/status.h"
+
+namespace solidtex {
+
+// How many table candidates per source pixel the correction considers (Zhang §4.3 uses all
+// N_T). kCoherent is our shortcut: the first 4 (the best by crossbar error), plus the current
+// triple; it keeps the coherent proposals that dominate the result at a third of the cost.
+enum class Matcher { kPaper, kCoherent };
+Result<Matcher> parse_matcher(const std::string& name);
+const char* matcher_name(Matcher m);
+
+enum class Scheme {
+  kStandard,  // P plain passes, every voxel updated per step, no barriers
+  kSubpass,   // P passes of s^3 subpasses, no barriers (Lefebvre-Hoppe / Dong et al.)
+  kGrid,      // subpasses + grid barriers: outside p's M^3 cell, read version 0
+  kDualGrid,  // ceil(P/2) grid passes, then floor(P/2) passes on cells shifted by M/2 whose
+              // barrier version is the grid passes' final version (Zhang §5.3)
+};
+
+Result<Scheme> parse_scheme(const std::string& name);
+const char* scheme_name(Scheme s);
+
+struct SynthesisParams {
+  Scheme scheme = Scheme::kDualGrid;
+  Matcher matcher = Matcher::kPaper;
+  int coarse_passes = 3;     // plain passes at the coarsest level (never barriered), [0, 8]
+  int passes = 2;            // correction passes at every finer level, [0, 8]
+  int subpass_size = 2;      // s: s^3 subpasses per pass for subpass/grid schemes, {1, 2}
+  int cell_size = 12;        // M: grid cell side in voxels of the level, [4, 64]
+  int init_subpart = 32;     // K: coarsest-level voxels per initialisation subpart side, even, [8, 256]
+  int trilinear_levels = 2;  // the coarsest this-many levels sample neighbourhoods trilinearly, [0, 8]
+  uint32_t seed = 1;         // hashed with (voxel, level) wherever synthesis needs randomness
+  // Relative weight of each plane (xy, yz, zx) in matching costs and voxel colours, [0, 1],
+  // not all zero. Zhang §6.1: a plane whose exemplar conflicts with the others in 3D (e.g.
+  // the end grain of a wood exemplar) is best given a small weight.
+  std::array<float, 3> plane_weights{1.f, 1.f, 1.f};
+
+  Status validate() const;
+};
+
+}  // namespace solidtex

@@ -1,0 +1,273 @@
+#include "synthesis/synthesizer.h"
+
+#include <gtest/gtest.h>
+#include <tbb/task_arena.h>
+
+#include "analysis/analysis.h"
+#include "testkit/quality.h"
+#include "synthesis/region_volume.h"
+#include "testkit/test_support.h"
+
+namespace solidtex {
+namespace {
+
+// A small but complete setup: 3 levels, N = 7, 48^2 procedural exemplars.
+std::shared_ptr<const Table> small_table(ProceduralKind kind, bool grain_x) {
+  ExemplarInputs in;
+  in.xy = testing::procedural(kind, 48, 48);
+  AnalysisParams p;
+  p.levels = 3;
+  p.neighborhood = 7;
+  p.candidates = 8;
+  p.pca_dims = 12;
+  if (grain_x) {
+    in.yz = in.xy;
+    in.zx = transposed(in.xy);
+    p.suggested_plane_weights = {1.f, 0.1f, 1.f};
+  }
+  auto set = ExemplarSet::create(std::move(in)).value();
+  return analyze(set, p).value().table;
+}
+
+SynthesisParams small_params(Scheme scheme = Scheme::kDualGrid) {
+  SynthesisParams p;
+  p.scheme = scheme;
+  p.coarse_passes = 2;
+  p.passes = 2;
+  p.cell_size = 8;
+  p.init_subpart = 16;
+  return p;
+}
+
+std::shared_ptr<Synthesizer> make(std::shared_ptr<const Table> t, const std::string& field, SynthesisParams p,
+                                  int64_t cache = 64 << 20) {
+  p.plane_weights = t->params().suggested_plane_weights;
+  return Synthesizer::create(t, parse_field_spec(field).value(), p, cache).value();
+}
+
+std::vector<std::array<float, 3>> cut(Synthesizer& s, char axis, int at, int u, int v, int w, int h,
+                                      SynthesisStats* st = nullptr, SynthesisOptions o = {}) {
+  auto r = s.synthesize(TargetSet::axis_cut(axis, at, u, v, w, h).value(), null_interrupter(), st, o);
+  EXPECT_TRUE(r.is_ok()) << r.status().to_string();
+  return r.is_ok() ? *r : std::vector<std::array<float, 3>>{};
+}
+
+ImageF to_image(const std::vector<std::array<float, 3>>& rgb, int w, int h) {
+  ImageF img(w, h, 3);
+  for (size_t i = 0; i < rgb.size(); ++i)
+    for (int c = 0; c < 3; ++c) img.pixels[i * 3 + size_t(c)] = rgb[i][size_t(c)];
+  return img;
+}
+
+class SynthesizerTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { table_ = small_table(ProceduralKind::kSpots, false); }
+  static std::shared_ptr<const Table> table_;
+};
+std::shared_ptr<const Table> SynthesizerTest::table_;
+
+TEST_F(SynthesizerTest, OverlappingCutsAgreeBitForBit) {
+  auto s = make(table_, "quat:0.9,0.1,0.3,0.2", small_params(), 0);
+  const auto a = cut(*s, 'z', 3, 0, 0, 20, 20);
+  const auto b = cut(*s, 'z', 3, 8, 5, 20, 20);
+  int compared = 0;
+  for (int j = 0; j < 20; ++j)
+    for (int i = 0; i < 20; ++i) {
+      const int bi = i - 8, bj = j - 5;
+      if (bi < 0 || bj < 0) continue;
+      ASSERT_EQ(a[size_t(j * 20 + i)], b[size_t(bj * 20 + bi)]) << i << "," << j;
+      ++compared;
+    }
+  EXPECT_EQ(compared, 12 * 15);
+}
+
+TEST_F(SynthesizerTest, ThreadsCacheStateAndPiecesDoNotChangeBits) {
+  const SynthesisParams p = small_params();
+  std::vector<std::array<float, 3>> one, two, warm, whole;
+  {
+    tbb::task_arena arena(1);
+    auto s = make(table_, "identity", p);
+    arena.execute([&] { one = cut(*s, 'x', -4, 2, 2, 24, 16); });
+  }
+  {
+    tbb::task_arena arena(2);
+    auto s = make(table_, "identity", p);
+    arena.execute([&] { two = cut(*s, 'x', -4, 2, 2, 24, 16); });
+    // Warm: an overlapping request first fills the cache, then the same cut again.
+    cut(*s, 'x', -4, 10, 0, 24, 24);
+    SynthesisStats st;
+    arena.execute([&] { warm = cut(*s, 'x', -4, 2, 2, 24, 16, &st); });
+    EXPECT_GT(st.levels.back().cache_hits, 0);
+    EXPECT_EQ(st.levels.back().cache_hits, st.levels.back().needed_final);  // all from cache
+  }
+  EXPECT_EQ(one, two);
+  EXPECT_EQ(one, warm);
+  // In pieces: top and bottom halves from a fresh synthesizer, requested bottom first.
+  auto s = make(table_, "identity", p, 0);
+  const auto bottom = cut(*s, 'x', -4, 2, 10, 24, 8);
+  const auto top = cut(*s, 'x', -4, 2, 2, 24, 8);
+  whole = top;
+  whole.insert(whole.end(), bottom.begin(), bottom.end());
+  EXPECT_EQ(one, whole);
+}
+
+TEST_F(SynthesizerTest, TinyCacheBudgetEvictsBricksAndKeepsResults) {
+  auto roomy = make(table_, "identity", small_params(), 64 << 20);
+  auto tiny = make(table_, "identity", small_params(), 64 << 10);  // 64 KiB: about ten leaves
+  const auto a1 = cut(*roomy, 'z', 2, 0, 0, 16, 16);
+  const auto b1 = cut(*tiny, 'z', 2, 0, 0, 16, 16);
+  const auto b2 = cut(*tiny, 'z', 2, 0, 0, 16, 16);  // partly re-synthesized after eviction
+  EXPECT_EQ(a1, b1);
+  EXPECT_EQ(a1, b2);
+  const auto c = tiny->cache().counters();
+  EXPECT_GT(c.evicted_bricks, 0);
+  EXPECT_LE(c.bytes, tiny->cache().budget_bytes());
+  EXPECT_GT(roomy->cache().counters().bricks, c.bricks);
+}
+
+TEST_F(SynthesizerTest, PlaneCutsAndPointsMatchAxisCuts) {
+  auto s = make(table_, "identity", small_params(), 0);
+  const auto axis = cut(*s, 'y', 7, -3, 4, 10, 6);
+  auto plane = s->synthesize(TargetSet::plane_cut({-3, 7, 4}, {1, 0, 0}, {0, 0, 1}, 10, 6).value()).value();
+  EXPECT_EQ(axis, plane);
+  std::vector<WorldPoint> pts{{-3, 7, 4}, {6.2, 7, 9.4}};
+  auto pv = s->synthesize(TargetSet::points(pts).value()).value();
+  EXPECT_EQ(pv[0], axis[0]);
+  EXPECT_EQ(pv[1], axis[size_t(5 * 10 + 9)]);
+}
+
+TEST_F(SynthesizerTest, DependencySetsAreSoundAndTightForEveryScheme) {
+  for (Scheme scheme : {Scheme::kStandard, Scheme::kSubpass, Scheme::kGrid, Scheme::kDualGrid}) {
+    for (const char* field : {"identity", "axis:1,2,3,37"}) {
+      SCOPED_TRACE(std::string(scheme_name(scheme)) + " " + field);
+      SynthesisParams p = small_params(scheme);
+      p.passes = 1;  // keeps the barrier-free schemes' sets small enough for a unit test
+      auto s = make(table_, field, p, 0);
+      SynthesisStats st;
+      SynthesisOptions o;
+      o.instrument = true;
+      cut(*s, 'z', 1, 0, 0, 6, 5, &st, o);
+      EXPECT_EQ(st.unsound_reads, 0);
+      EXPECT_EQ(st.unread_required, 0);
+      EXPECT_GT(st.corrections, 0);
+    }
+  }
+}
+
+TEST_F(SynthesizerTest, VaryingFieldIsSoundTightAndDeterministic) {
+  // A 2x2x2 quaternion grid turning 90 degrees across 40 voxels.
+  std::vector<Quat> q;
+  for (int z = 0; z < 2; ++z)
+    for (int y = 0; y < 2; ++y)
+      for (int x = 0; x < 2; ++x) q.push_back(Quat::from_axis_angle(0, 0.3, 1, (x + y + z) * 0.5));
+  auto grid = QuatGridField::create({-20, -20, -20}, 40, {2, 2, 2}, q).value();
+  SynthesisParams p = small_params();
+  p.passes = 1;
+  auto s = Synthesizer::create(table_, grid, p, 0).value();
+  SynthesisStats st;
+  SynthesisOptions o;
+  o.instrument = true;
+  auto a = s->synthesize(TargetSet::plane_cut({0, 0, 0}, {0.7, 0.7, 0}, {0, 0.6, 0.8}, 6, 6).value(),
+                         null_interrupter(), &st, o);
+  ASSERT_TRUE(a.is_ok());
+  EXPECT_EQ(st.unsound_reads, 0);
+  EXPECT_EQ(st.unread_required, 0);
+  auto b = s->synthesize(TargetSet::plane_cut({0, 0, 0}, {0.7, 0.7, 0}, {0, 0.6, 0.8}, 6, 6).value());
+  EXPECT_EQ(*a, *b);
+}
+
+TEST_F(SynthesizerTest, DualGridNeedsFarFewerVoxelsThanPlainSubpasses) {
+  SynthesisParams p = small_params(Scheme::kSubpass);
+  p.passes = 2;
+  p.cell_size = 8;
+  SynthesisStats plain, dual;
+  cut(*make(table_, "identity", p, 0), 'z', 0, 0, 0, 32, 32, &plain);
+  p.scheme = Scheme::kDualGrid;
+  cut(*make(table_, "identity", p, 0), 'z', 0, 0, 0, 32, 32, &dual);
+  const auto fine = size_t(table_->levels() - 1);
+  RecordProperty("finest_voxels_subpass", std::to_string(plain.levels[fine].voxels));
+  RecordProperty("finest_voxels_dual_grid", std::to_string(dual.levels[fine].voxels));
+  EXPECT_LT(dual.levels[fine].voxels, plain.levels[fine].voxels * 6 / 10);
+}
+
+TEST_F(SynthesizerTest, CorrectionLowersMatchingEnergyAndDualGridKeepsQuality) {
+  const ImageF& exemplar = table_->exemplars().plane(Plane::kXY);
+  // Mean over the three axis orientations: the slab initialisation copies the exemplar into
+  // z-cuts but extrudes it in x- and y-cuts; correction must make every orientation match.
+  auto energy = [&](SynthesisParams p) {
+    auto s = make(table_, "identity", p, 0);
+    double e = 0;
+    for (char axis : {'x', 'y', 'z'}) {
+      const double ea = neighbourhood_energy(to_image(cut(*s, axis, 5, 0, 0, 40, 40), 40, 40), exemplar, 7, 2);
+      e += ea / 3;
+    }
+    return e;
+  };
+  SynthesisParams none = small_params(Scheme::kSubpass);
+  none.coarse_passes = 0;
+  none.passes = 0;
+  const double e_init = energy(none);
+  const double e_subpass = energy(small_params(Scheme::kSubpass));
+  const double e_dual = energy(small_params(Scheme::kDualGrid));
+  RecordProperty("energy_init", std::to_string(e_init));
+  RecordProperty("energy_subpass", std::to_string(e_subpass));
+  RecordProperty("energy_dual_grid", std::to_string(e_dual));
+  EXPECT_LT(e_subpass, 0.8 * e_init) << e_subpass << " vs init " << e_init;
+  EXPECT_LT(e_dual, 1.1 * e_subpass) << e_dual << " vs subpass " << e_subpass;
+}
+
+TEST(SynthesizerOrientation, ConstantRotationTurnsTheGrain) {
+  auto table = small_table(ProceduralKind::kStripes, true);
+  SynthesisParams p = small_params();
+  auto angle = [&](const std::string& field) {
+    auto s = make(table, field, p, 0);
+    return dominant_orientation_degrees(to_image(cut(*s, 'z', 0, 0, 0, 48, 48), 48, 48));
+  };
+  const double straight = angle("identity");
+  const double turned = angle("axis:0,0,1,45");
+  RecordProperty("orientation_identity", std::to_string(straight));
+  RecordProperty("orientation_rotated", std::to_string(turned));
+  EXPECT_NEAR(straight, 0.0, 5.0);
+  EXPECT_NEAR(turned - straight, 45.0, 5.0);
+}
+
+TEST(RegionVolume, LabelsPickTheRightTableOnBothSidesOfASplit) {
+  auto spots = small_table(ProceduralKind::kSpots, false);
+  auto noise = small_table(ProceduralKind::kNoise, false);
+  auto a = make(spots, "identity", small_params(), 0);
+  auto b = make(noise, "identity", small_params(), 0);
+  auto volume = RegionVolume::create({a, b}, RegionLabel::parse("halfspace:1,0,0,0").value()).value();
+  const auto target = TargetSet::axis_cut('z', 1, -10, 0, 20, 12).value();
+  auto mixed = volume->synthesize(target).value();
+  const auto only_a = cut(*make(spots, "identity", small_params(), 0), 'z', 1, -10, 0, 20, 12);
+  const auto only_b = cut(*make(noise, "identity", small_params(), 0), 'z', 1, -10, 0, 20, 12);
+  for (int j = 0; j < 12; ++j)
+    for (int i = 0; i < 20; ++i) {
+      const size_t s = size_t(j * 20 + i);
+      // x = -10 + i: x < 0 is region 0 (spots), x >= 0 region 1 (noise), bit for bit.
+      ASSERT_EQ(mixed[s], (i < 10 ? only_a : only_b)[s]) << i << "," << j;
+    }
+  EXPECT_NE(only_a, only_b);
+  EXPECT_FALSE(RegionLabel::parse("halfspace:0,0,0,1").is_ok());
+  EXPECT_FALSE(RegionLabel::parse("ball:1,2").is_ok());
+  EXPECT_EQ(RegionLabel::parse("box:0,0,0,4,4,4").value().label_of({2, 2, 2}), 1);
+}
+
+TEST(Synthesizer, RejectsBadInputAndHonoursCancellation) {
+  auto table = small_table(ProceduralKind::kSpots, false);
+  SynthesisParams bad = small_params();
+  bad.cell_size = 2;
+  EXPECT_EQ(Synthesizer::create(table, parse_field_spec("identity").value(), bad, 0).status().field(), "cell_size");
+  EXPECT_FALSE(parse_field_spec("quat:0,0,0,0").is_ok());
+  EXPECT_FALSE(parse_field_spec("bogus").is_ok());
+  EXPECT_EQ(TargetSet::axis_cut('q', 0, 0, 0, 4, 4).status().field(), "axis");
+  EXPECT_EQ(TargetSet::axis_cut('z', 0, 0, 0, 100000, 100000).status().code(), StatusCode::kTooLarge);
+  struct Stop : Interrupter {
+    bool was_interrupted(int) override { return true; }
+  } stop;
+  auto s = make(table, "identity", small_params(), 0);
+  EXPECT_EQ(s->synthesize(TargetSet::axis_cut('z', 0, 0, 0, 8, 8).value(), stop).status().code(), StatusCode::kCancelled);
+}
+
+}  // namespace
+}  // namespace solidtex

@@ -1,0 +1,95 @@
+#include "testkit/quality.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "analysis/knn_index.h"
+#include "analysis/neighborhood.h"
+
+namespace solidtex {
+
+double dominant_orientation_degrees(const ImageF& img) {
+  auto lum = [&](int x, int y) {
+    const float* p = img.at(x, y);
+    return img.channels >= 3 ? 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2] : double(p[0]);
+  };
+  double jxx = 0, jyy = 0, jxy = 0;
+  for (int y = 1; y + 1 < img.height; ++y)
+    for (int x = 1; x + 1 < img.width; ++x) {
+      const double gx = 0.5 * (lum(x + 1, y) - lum(x - 1, y));
+      const double gy = 0.5 * (lum(x, y + 1) - lum(x, y - 1));
+      jxx += gx * gx;
+      jyy += gy * gy;
+      jxy += gx * gy;
+    }
+  // Gradient direction, then the stripes run perpendicular to it.
+  double gradient = 0.5 * std::atan2(2 * jxy, jxx - jyy) * 180.0 / M_PI;
+  double stripes = gradient + 90.0;
+  while (stripes > 90.0) stripes -= 180.0;
+  while (stripes <= -90.0) stripes += 180.0;
+  return stripes;
+}
+
+double dominant_period_x(const ImageF& img) {
+  const int w = img.width;
+  std::vector<double> power(size_t(w / 2 + 1), 0.0);
+  std::vector<double> row(static_cast<size_t>(w));
+  for (int y = 0; y < img.height; ++y) {
+    double mean = 0;
+    for (int x = 0; x < w; ++x) {
+      const float* p = img.at(x, y);
+      row[size_t(x)] = img.channels >= 3 ? 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2] : p[0];
+      mean += row[size_t(x)] / w;
+    }
+    for (int k = 1; k <= w / 2; ++k) {
+      double re = 0, im = 0;
+      for (int x = 0; x < w; ++x) {
+        re += (row[size_t(x)] - mean) * std::cos(2 * M_PI * k * x / w);
+        im -= (row[size_t(x)] - mean) * std::sin(2 * M_PI * k * x / w);
+      }
+      power[size_t(k)] += re * re + im * im;
+    }
+  }
+  int best = 2;
+  for (int k = 2; k <= w / 2; ++k)
+    if (power[size_t(k)] > power[size_t(best)]) best = k;
+  double peak = best;
+  if (best > 1 && best < w / 2) {
+    const double a = power[size_t(best - 1)], b = power[size_t(best)], c = power[size_t(best + 1)];
+    const double denom = a - 2 * b + c;
+    if (denom != 0) peak = best + 0.5 * (a - c) / denom;
+  }
+  return double(w) / peak;
+}
+
+double neighbourhood_energy(const ImageF& cut, const ImageF& exemplar, int n, int stride) {
+  const int dims = neighborhood_dims(n, exemplar.channels);
+  std::vector<float> ex(size_t(exemplar.pixel_count()) * dims);
+  for (int y = 0; y < exemplar.height; ++y)
+    for (int x = 0; x < exemplar.width; ++x)
+      gather_neighborhood(exemplar, {x, y}, n, 1, &ex[(size_t(y) * exemplar.width + x) * dims]);
+  const int h = n / 2;
+  std::vector<std::pair<int, int>> centres;
+  for (int y = h; y + h < cut.height; y += stride)
+    for (int x = h; x + h < cut.width; x += stride) centres.emplace_back(x, y);
+  std::vector<double> best(centres.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, centres.size()), [&](const tbb::blocked_range<size_t>& r) {
+    std::vector<float> q(static_cast<size_t>(dims));
+    std::vector<int> idx;
+    std::vector<float> dist;
+    for (size_t i = r.begin(); i != r.end(); ++i) {
+      gather_neighborhood(cut, {centres[i].first, centres[i].second}, n, 1, q.data());
+      exact_knn(ex.data(), int(exemplar.pixel_count()), dims, q.data(), 1, idx, dist);
+      best[i] = dist[0] / dims;
+    }
+  });
+  double sum = 0;
+  for (double b : best) sum += b;
+  return centres.empty() ? 0.0 : sum / double(centres.size());
+}
+
+}  // namespace solidtex

@@ -1,0 +1,21 @@
+// Image measures used by tests and benchmarks to judge synthesized cuts.
+#pragma once
+
+#include "core/image.h"
+
+namespace solidtex {
+
+// Dominant orientation of stripes in an image, in degrees in (-90, 90], measured by the
+// structure tensor of luminance (0 = stripes running along x, 90 = along y).
+double dominant_orientation_degrees(const ImageF& image);
+
+// Dominant period along x in pixels: the peak of the summed power spectra of the rows (mean
+// removed), refined by parabolic interpolation between frequency bins (>= 2 cycles).
+double dominant_period_x(const ImageF& image);
+
+// Neighbourhood-matching energy: the mean, over every N x N neighbourhood that fits inside
+// `cut` (taken every `stride` pixels), of the squared distance per element to its nearest
+// neighbourhood of `exemplar` (toroidal). Lower means the cut looks more like the exemplar.
+double neighbourhood_energy(const ImageF& cut, const ImageF& exemplar, int n, int stride = 1);
+
+}  // namespace solidtex
