@@ -1,7 +1,7 @@
 // Benchmark: lazy synthesis of cuts. Prints one JSON object.
 //   bench_slice TABLE.stx [--quick]
 // 1. dependency-set sizes (voxels, corrections per level) of a 512x512 axis cut and a
-//    512x512 oblique cut under standard, subpass and dual-grid correction (sets only);
+//    512x512 oblique cut under plain, subpass and dual-grid correction (sets only);
 // 2. full synthesis of a 128x128 cut: corrections per second, paper and coherent matchers;
 // 3. a new 256x256 cut once another cut has warmed the cache (coarse levels cached), then the
 //    same cut again entirely from the cache.
@@ -64,8 +64,8 @@ int main(int argc, char** argv) {
   cuts.push_back({"oblique", TargetSet::plane_cut({0, 0, 0}, {0.6, 0.8, 0}, {-0.48, 0.36, 0.8}, big, big).value()});
   nlohmann::json sets = nlohmann::json::array();
   for (const Cut& c : cuts) {
-    int64_t standard_voxels = 0;
-    for (Scheme scheme : {Scheme::kStandard, Scheme::kSubpass, Scheme::kDualGrid}) {
+    int64_t subpass_voxels = 0;
+    for (Scheme scheme : {Scheme::kPlain, Scheme::kSubpass, Scheme::kDualGrid}) {
       auto s = make(*table, scheme, Matcher::kPaper, 0);
       SynthesisStats st;
       SynthesisOptions o;
@@ -76,7 +76,7 @@ int main(int argc, char** argv) {
         std::cerr << r.status().to_string() << "\n";
         return 1;
       }
-      if (scheme == Scheme::kSubpass) standard_voxels = st.voxels;
+      if (scheme == Scheme::kSubpass) subpass_voxels = st.voxels;
       nlohmann::json j = {{"cut", c.name},
                           {"size", big},
                           {"scheme", scheme_name(scheme)},
@@ -84,8 +84,8 @@ int main(int argc, char** argv) {
                           {"corrections", st.corrections},
                           {"analysis_seconds", st.dependency_seconds},
                           {"levels", level_json(st)}};
-      if (scheme == Scheme::kDualGrid && standard_voxels > 0)
-        j["voxels_vs_subpass"] = double(st.voxels) / double(standard_voxels);
+      if (scheme == Scheme::kDualGrid && subpass_voxels > 0)
+        j["voxels_vs_subpass"] = double(st.voxels) / double(subpass_voxels);
       sets.push_back(j);
     }
   }

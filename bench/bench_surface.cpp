@@ -1,7 +1,7 @@
 // Benchmark: texturing meshes lazily. Prints one JSON object.
 //   bench_surface TABLE.stx MESH_DIR [--resolutions 512,1024] [--synthesize-up-to N]
 // For bunny, fertility, horse and armadillo at each resolution (placement: bounding box
-// enlarged by 25% per side, longest side = resolution voxels), standard, subpass and dual-grid:
+// enlarged by 25% per side, longest side = resolution voxels), plain, subpass and dual-grid:
 // vertices, distinct target voxels, the placed bounding box's voxels, the dependency sets
 // (voxels and corrections over all levels, and per level), their fraction of the bounding
 // box, and -- when the dual-grid correction count is at most --synthesize-up-to (default
@@ -76,7 +76,7 @@ int main(int argc, char** argv) {
       }
       const TargetSet target = std::move(*points);
       const int64_t bounding = bounding_voxels(mesh->bounds(), placement);
-      for (Scheme scheme : {Scheme::kStandard, Scheme::kSubpass, Scheme::kDualGrid}) {
+      for (Scheme scheme : {Scheme::kPlain, Scheme::kSubpass, Scheme::kDualGrid}) {
         SynthesisParams p;
         p.scheme = scheme;
         p.plane_weights = (*table)->params().suggested_plane_weights;

@@ -1,5 +1,5 @@
 // solidtex slice TABLE.stx (--axis x|y|z --at K --origin U,V | --plane OX,OY,OZ,UX,UY,UZ,VX,VY,VZ)
-//   --size W,H [--scheme standard|subpass|grid|dual-grid] [--field identity|quat:W,X,Y,Z|axis:..|FILE]
+//   --size W,H [--scheme plain|subpass|grid|dual-grid] [--field identity|quat:W,X,Y,Z|axis:..|FILE]
 //   [--seed S] [--threads T] [--passes P] [--coarse-passes P] [--cell M] -o OUT.png [--stats STATS.json]
 #include <nlohmann/json.hpp>
 
@@ -121,8 +121,8 @@ Status run_slice(const std::vector<std::string>& argv) {
   j["matcher"] = matcher_name(params.matcher);
   j["field"] = field->describe();
   if (args.has("--energy")) {
-    // Neighbourhood-matching energy of the cut against exemplar xy (quality.h).
-    j["energy"] = neighbourhood_energy(img, table->exemplars().plane(Plane::kXY), table->params().neighborhood, 2);
+    // Neighborhood-matching energy of the cut against exemplar xy (quality.h).
+    j["energy"] = neighborhood_energy(img, table->exemplars().plane(Plane::kXY), table->params().neighborhood, 2);
     std::cerr << "energy " << j["energy"] << "\n";
   }
   if (auto path = args.get("--stats")) {

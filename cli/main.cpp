@@ -27,7 +27,7 @@ constexpr const char* kUsage =
     "  analyze IMAGE [--yz IMAGE --zx IMAGE] [--mask IMAGE] [--levels 4] [--neighborhood 9]\n"
     "          [--candidates 12] [--pca-dims 20] [--seed S] [--threads T] -o TABLE.stx [--json]\n"
     "  slice TABLE.stx (--axis x|y|z --at K [--origin U,V] | --plane OX,OY,OZ,UX,UY,UZ,VX,VY,VZ)\n"
-    "          --size W,H [--scheme standard|subpass|grid|dual-grid] [--field identity|quat:W,X,Y,Z|FILE]\n"
+    "          --size W,H [--scheme plain|subpass|grid|dual-grid] [--field identity|quat:W,X,Y,Z|FILE]\n"
     "          [--seed S] [--threads T] -o OUT.png [--stats STATS.json]\n"
     "  field SKETCH.json -o FIELD.stf [--json]\n"
     "  serve [--host 127.0.0.1] [--port 8080] [--data DIR] [--threads N] [--queue N] [--deadline S]\n"

@@ -31,7 +31,7 @@ analysis_params = [
     qp("seed", "Seeds the k-NN trees.", {"type": "integer", "minimum": 0, "default": 1}),
     qp("plane_weights", "Suggested plane weights 'A,B,C' stored with the table.", {"type": "string"}),
     qp("grain", "'x': the exemplar's stripes run along its x axis and the solid's grain along world x: xy = E, zx = E transposed, yz = E with suggested weight 0.1 (as `solidtex analyze --grain x`).", {"type": "string", "enum": ["x"]}),
-    qp("mask_weight", "Weight of the feature-mask channel relative to colour.", {"type": "number", "minimum": 0, "maximum": 10, "default": 1}),
+    qp("mask_weight", "Weight of the feature-mask channel relative to color.", {"type": "number", "minimum": 0, "maximum": 10, "default": 1}),
 ]
 S = {
  "Error": {"type": "object", "required": ["error"], "properties": {"error": {"type": "object", "required": ["code", "message", "field"], "properties": {
@@ -71,7 +71,7 @@ S = {
      "size": {"type": "array", "items": {"type": "integer"}, "minItems": 2, "maxItems": 2, "description": "W, H."}}},
  "Mesh": {"type": "object", "required": ["id"], "properties": {
      "id": {"type": "string"}, "name": {"type": "string"}, "format": {"type": "string", "enum": ["ply", "obj", "off"]},
-     "vertices": {"type": "integer", "description": "Every vertex position of the file, unreferenced ones included (they get colours too); OBJ texture coordinates and normals are ignored."}, "triangles": {"type": "integer", "description": "After fan triangulation of polygons and removal of duplicate and degenerate faces."},
+     "vertices": {"type": "integer", "description": "Every vertex position of the file, unreferenced ones included (they get colors too); OBJ texture coordinates and normals are ignored."}, "triangles": {"type": "integer", "description": "After fan triangulation of polygons and removal of duplicate and degenerate faces."},
      "bounds": {"type": "object", "properties": {"min": {"type": "array", "items": {"type": "number"}}, "max": {"type": "array", "items": {"type": "number"}}}},
      "defects": {"type": "object", "description": "What the reader tolerated: duplicate_faces and degenerate_faces (dropped), unreferenced_vertices, boundary_edges (holes), non_manifold_edges, components.",
                  "properties": {k: {"type": "integer"} for k in ["duplicate_faces", "degenerate_faces", "unreferenced_vertices", "boundary_edges", "non_manifold_edges", "components", "polygons_triangulated"]}}}},
@@ -82,7 +82,7 @@ S = {
      "mesh": {"type": "string", "description": "Id of a stored mesh."},
      "placement": ref("Placement"),
      "format": {"type": "string", "enum": ["ply", "json"], "default": "ply"},
-     "points": {"type": "array", "description": "Extra surface points (mesh coordinates) to colour as well (JSON format only).", "items": {"type": "array", "items": {"type": "number"}, "minItems": 3, "maxItems": 3}}}},
+     "points": {"type": "array", "description": "Extra surface points (mesh coordinates) to color as well (JSON format only).", "items": {"type": "array", "items": {"type": "number"}, "minItems": 3, "maxItems": 3}}}},
  "SurfaceColors": {"type": "object", "properties": {
      "vertices": {"type": "integer"}, "colors": {"type": "array", "description": "Linear RGB per vertex (float).", "items": {"type": "array", "items": {"type": "number"}}},
      "point_colors": {"type": "array", "items": {"type": "array", "items": {"type": "number"}}},
@@ -158,7 +158,7 @@ paths = {
      "responses": {"200": {"description": "The voxels.", "headers": {"X-Shape": {"schema": {"type": "string"}}, "X-Dtype": {"schema": {"type": "string"}}},
                             "content": {"application/x-vdb": {"schema": {"type": "string", "format": "binary"}}, "application/octet-stream": {"schema": {"type": "string", "format": "binary"}}}}, **errs("400", "404", "422", "503", "504")}}},
  "/v1/volumes/{id}/points": {"parameters": [pid()],
-   "post": {"operationId": "points", "summary": "Colours at world points (each rounded to its nearest finest voxel).", "parameters": [timeout],
+   "post": {"operationId": "points", "summary": "Colors at world points (each rounded to its nearest finest voxel).", "parameters": [timeout],
      "requestBody": {"required": True, "content": {"application/octet-stream": {"schema": {"type": "string", "format": "binary", "description": "Little-endian float32 x,y,z per point."}}, "application/json": {"schema": {"type": "object", "additionalProperties": False, "required": ["points"], "properties": {"points": {"type": "array", "items": {"type": "array", "items": {"type": "number"}, "minItems": 3, "maxItems": 3}}}}}}},
      "responses": {"200": {"description": "Linear RGB per point: raw little-endian float32 (N x 3, `X-Shape: N,3`) by default, or JSON {\"rgb\": [[r,g,b], ...]} with `Accept: application/json`.",
                             "content": {"application/octet-stream": {"schema": {"type": "string", "format": "binary"}}, "application/json": {"schema": {"type": "object", "properties": {"rgb": {"type": "array"}}}}}}, **errs("400", "404", "413", "415", "422", "503", "504")}}},
@@ -173,11 +173,11 @@ paths = {
  "/v1/meshes/{id}/file": {"parameters": [pid()],
    "get": {"operationId": "get_mesh_file", "summary": "The mesh as stored: binary little-endian PLY of the cleaned triangles (positions in mesh coordinates).", "responses": {"200": {"description": "OK", "content": {"application/octet-stream": {"schema": {"type": "string", "format": "binary"}}}}, **errs("404")}}},
  "/v1/volumes/{id}/surface": {"parameters": [pid()],
-   "post": {"operationId": "surface", "summary": "Texture a mesh: synthesize only the voxels its vertices need (each vertex takes the colour of its nearest finest voxel, exactly what `points` answers at the placed vertex) and return the coloured mesh.",
+   "post": {"operationId": "surface", "summary": "Texture a mesh: synthesize only the voxels its vertices need (each vertex takes the color of its nearest finest voxel, exactly what `points` answers at the placed vertex) and return the colored mesh.",
      "description": "Body: a SurfaceRequest (application/json) naming a stored mesh, or the mesh bytes themselves (any other Content-Type) with `resolution`, `margin` and `format` in the query. PLY answers are binary little-endian with float x,y,z (mesh coordinates), uchar red, green, blue (sRGB8) per vertex and the triangles; headers X-Target-Voxels, X-Bounding-Voxels, X-Voxels-Synthesized.",
      "parameters": [timeout, qp("resolution", "With a mesh body: voxels along the longest side.", {"type": "integer"}), qp("margin", "With a mesh body.", {"type": "number"}), qp("format", "With a mesh body: ply or json.", {"type": "string"})],
      "requestBody": {"required": True, "content": {"application/json": {"schema": ref("SurfaceRequest")}, "application/octet-stream": {"schema": {"type": "string", "format": "binary"}}}},
-     "responses": {"200": {"description": "The coloured mesh.", "content": {"application/x-ply": {"schema": {"type": "string", "format": "binary"}}, "application/json": {"schema": ref("SurfaceColors")}}}, **errs("400", "404", "413", "415", "422", "503", "504")}}},
+     "responses": {"200": {"description": "The colored mesh.", "content": {"application/x-ply": {"schema": {"type": "string", "format": "binary"}}, "application/json": {"schema": ref("SurfaceColors")}}}, **errs("400", "404", "413", "415", "422", "503", "504")}}},
  "/v1/fields/from-mesh": {
    "post": {"operationId": "field_from_mesh", "summary": "Solve a frame field from a stored mesh's geometry: principal-curvature frames or crest-line curves as soft constraints (harmonic interpolation, like sketches). The field's domain is the placed mesh's box (world units), so a volume using it should place the mesh the same way.", "parameters": [timeout],
      "requestBody": {"required": True, "content": {"application/json": {"schema": ref("FieldFromMesh")}}},

@@ -63,8 +63,8 @@ ImageF to_image(const std::vector<std::array<float, 3>>& rgb, int width, int hei
   return img;
 }
 
-// Encodes colours laid out as `shape` (outermost first, last = 3) in the negotiated form.
-Result<HttpResponse> encode_colours(const std::vector<std::array<float, 3>>& rgb, int width, int height,
+// Encodes colors laid out as `shape` (outermost first, last = 3) in the negotiated form.
+Result<HttpResponse> encode_colors(const std::vector<std::array<float, 3>>& rgb, int width, int height,
                                     const std::string& shape, Encoding enc) {
   HttpResponse out;
   switch (enc) {
@@ -318,7 +318,7 @@ Result<HttpResponse> Api::synthesize_image(const HttpRequest& r, const std::stri
   SOLIDTEX_ASSIGN_OR_RETURN(auto q, query_volume(r, kind, target, timeout));
   const std::string shape = std::to_string(target.height) + "," + std::to_string(target.width) + ",3";
   SOLIDTEX_ASSIGN_OR_RETURN(HttpResponse out,
-                            encode_colours(q.rgb, target.width, target.height, shape, negotiate(r.accept, Encoding::kPng)));
+                            encode_colors(q.rgb, target.width, target.height, shape, negotiate(r.accept, Encoding::kPng)));
   out.headers.push_back({"X-Voxels-Synthesized", std::to_string(q.voxels_synthesized)});
   return out;
 }
@@ -383,7 +383,7 @@ HttpResponse Api::region(const HttpRequest& r) {
       out.content_type = "application/x-vdb";
     } else {
       const std::string shape = std::to_string(size[2]) + "," + std::to_string(size[1]) + "," + std::to_string(size[0]) + ",3";
-      SOLIDTEX_ASSIGN_OR_RETURN(out, encode_colours(qr->rgb, size[0], size[1] * size[2], shape, enc));
+      SOLIDTEX_ASSIGN_OR_RETURN(out, encode_colors(qr->rgb, size[0], size[1] * size[2], shape, enc));
     }
     out.headers.push_back({"X-Voxels-Synthesized", std::to_string(qr->voxels_synthesized)});
     return out;
@@ -431,7 +431,7 @@ HttpResponse Api::points(const HttpRequest& r) {
     if (!qr) return qr.status();
     const Encoding enc = r.accept.find("application/json") != std::string::npos ? Encoding::kJson : Encoding::kFloat32;
     SOLIDTEX_ASSIGN_OR_RETURN(HttpResponse out,
-                              encode_colours(qr->rgb, int(pts.size()), 1, std::to_string(pts.size()) + ",3", enc));
+                              encode_colors(qr->rgb, int(pts.size()), 1, std::to_string(pts.size()) + ",3", enc));
     out.headers.push_back({"X-Voxels-Synthesized", std::to_string(qr->voxels_synthesized)});
     return out;
   }();

@@ -13,7 +13,7 @@ Result<std::string> encode_vdb_box(const Voxel& min, std::array<int, 3> size,
   static std::once_flag init;
   std::call_once(init, [] { openvdb::initialize(); });
   const size_t n = size_t(size[0]) * size_t(size[1]) * size_t(size[2]);
-  if (rgb.size() != n) return Status(StatusCode::kInternal, "colour count does not match the box");
+  if (rgb.size() != n) return Status(StatusCode::kInternal, "color count does not match the box");
   try {
     auto grid = openvdb::Vec3SGrid::create(openvdb::Vec3s(0, 0, 0));
     grid->setName("color");

@@ -89,7 +89,7 @@ def _parser() -> argparse.ArgumentParser:
     group.add_argument("--field-spec", help="identity | quat:W,X,Y,Z | axis:X,Y,Z,DEG [;scale:SX,SY,SZ]")
     vo.add_argument("--seed", type=int)
     vo.add_argument("--name")
-    vo.add_argument("--scheme", choices=["standard", "subpass", "grid", "dual-grid"])
+    vo.add_argument("--scheme", choices=["plain", "subpass", "grid", "dual-grid"])
     vo.add_argument("--matcher", choices=["paper", "coherent"])
 
     sl = sub.add_parser("slice", help="axis-aligned cut to a PNG")
@@ -132,9 +132,9 @@ def _parser() -> argparse.ArgumentParser:
                     help="voxels along the mesh's longest side (server default 512)")
     rd.add_argument("--margin", type=float,
                     help="fraction of the longest side added on every side (server default 0.25)")
-    rd.add_argument("--no-light", action="store_true", help="unshaded vertex colours")
+    rd.add_argument("--no-light", action="store_true", help="unshaded vertex colors")
     rd.add_argument("--up", choices=["y", "z"], default="y", help="the mesh's up axis (default y)")
-    rd.add_argument("--ply", help="also write the coloured mesh to this PLY file")
+    rd.add_argument("--ply", help="also write the colored mesh to this PLY file")
     rd.add_argument("--timeout", type=float, help="server deadline, seconds")
     return p
 

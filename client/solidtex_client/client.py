@@ -1,7 +1,7 @@
 """HTTP client for the solidtex service: one method per operation of proto/openapi.json.
 
 Units: world coordinates and sizes are finest-level voxels; timeouts and deadlines are
-seconds. Colours: ``uint8`` answers are sRGB-encoded 8-bit, ``float32`` answers are linear RGB.
+seconds. Colors: ``uint8`` answers are sRGB-encoded 8-bit, ``float32`` answers are linear RGB.
 Every error answer raises the :mod:`solidtex_client.errors` exception for its status.
 """
 from __future__ import annotations
@@ -426,19 +426,19 @@ class Client:
                 mesh: Optional[MeshInput] = None,
                 placement: Optional[Mapping[str, Any]] = None, fmt: str = "ply",
                 points: Any = None, timeout: Optional[float] = None) -> Any:
-        """POST /v1/volumes/{id}/surface: colour a mesh's vertices from the volume.
+        """POST /v1/volumes/{id}/surface: color a mesh's vertices from the volume.
 
         Name a stored mesh (``mesh_id``) or send one (``mesh``: a path or bytes). Each
-        vertex gets the colour of the finest voxel nearest its placed position
+        vertex gets the color of the finest voxel nearest its placed position
         ``world = scale * mesh + translate``. ``placement``: ``{"resolution": R, "margin":
         M}`` (fit the bounding box, enlarged by M of its longest side on every side, to R
         voxels along the longest side, min corner at the origin; default 512 and 0.25) or
         ``{"scale": s, "translate": [x, y, z]}`` (stored meshes only: a sent mesh takes
         resolution and margin in the query).
 
-        ``fmt="ply"`` -> :class:`~solidtex_client.mesh.ColoredMesh` (sRGB8 colours; its
+        ``fmt="ply"`` -> :class:`~solidtex_client.mesh.ColoredMesh` (sRGB8 colors; its
         ``headers`` hold X-Target-Voxels, X-Bounding-Voxels, X-Voxels-Synthesized).
-        ``fmt="json"`` -> the answer dict with ``colors`` (and ``point_colors``, the colours of
+        ``fmt="json"`` -> the answer dict with ``colors`` (and ``point_colors``, the colors of
         the extra mesh-coordinate ``points``, stored meshes only) as linear float32 (N, 3)
         arrays, ``placement`` and ``stats``. ``timeout`` is the server-side deadline, seconds.
         """

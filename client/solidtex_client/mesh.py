@@ -1,4 +1,4 @@
-"""Coloured triangle meshes as the service sends them (``POST /v1/volumes/{id}/surface``).
+"""Colored triangle meshes as the service sends them (``POST /v1/volumes/{id}/surface``).
 
 The PLY answer is binary little-endian 1.0 with exactly::
 
@@ -29,7 +29,7 @@ _FACE_DTYPE = np.dtype([("n", "u1"), ("i", "<i4", (3,))])  # packed: 13 bytes pe
 
 
 class PlyFormatError(ValueError):
-    """The bytes are not a coloured PLY in the layout the service sends."""
+    """The bytes are not a colored PLY in the layout the service sends."""
 
 
 def mesh_bytes(mesh: MeshInput) -> bytes:
@@ -44,7 +44,7 @@ def mesh_bytes(mesh: MeshInput) -> bytes:
 
 @dataclass
 class ColoredMesh:
-    """A triangle mesh with one sRGB8 colour per vertex.
+    """A triangle mesh with one sRGB8 color per vertex.
 
     ``vertices`` float32 (N, 3) in mesh coordinates, ``colors`` uint8 (N, 3) sRGB,
     ``faces`` int32 (M, 3) vertex indices, ``headers`` the HTTP headers of the answer
@@ -63,11 +63,11 @@ class ColoredMesh:
         if self.colors.dtype != np.uint8:
             c = self.colors
             if c.size and (np.min(c) < 0 or np.max(c) > 255):
-                raise ValueError("colours must lie in [0, 255]")
+                raise ValueError("colors must lie in [0, 255]")
             self.colors = c.astype(np.uint8)
         self.faces = np.ascontiguousarray(np.asarray(self.faces, dtype=np.int32).reshape(-1, 3))
         if len(self.colors) != len(self.vertices):
-            raise ValueError(f"{len(self.vertices)} vertices but {len(self.colors)} colours")
+            raise ValueError(f"{len(self.vertices)} vertices but {len(self.colors)} colors")
         if self.faces.size and (self.faces.min() < 0 or self.faces.max() >= len(self.vertices)):
             raise ValueError("face index out of range")
 
@@ -113,7 +113,7 @@ def _header(data: bytes) -> Tuple[List[List[str]], int]:
 
 
 def parse_colored_ply(data: Union[bytes, bytearray, memoryview]) -> ColoredMesh:
-    """A :class:`ColoredMesh` from the service's coloured PLY bytes (layout: module doc).
+    """A :class:`ColoredMesh` from the service's colored PLY bytes (layout: module doc).
 
     Raises :class:`PlyFormatError` for another format (ASCII, big-endian), other or missing
     properties, non-triangle faces, out-of-range indices, or a body of the wrong length.

@@ -1,8 +1,8 @@
-"""A small software renderer for coloured triangle meshes (numpy only).
+"""A small software renderer for colored triangle meshes (numpy only).
 
 Orthographic camera looking at the centre of the mesh's bounding box from ``azimuth`` and
 ``elevation`` degrees, the mesh fit to the image with a small border, a z-buffer, per-vertex
-colours interpolated barycentrically, optional Lambert shading with face normals
+colors interpolated barycentrically, optional Lambert shading with face normals
 (``ambient 0.35 + 0.65 |n . l|``, light from the camera, a little above and to the left), white
 background; the silhouette is centred in the image. Triangles are rasterised in batches of
 similar screen size, so ~100K triangles take well under a second at 512x512; triangles that
@@ -52,7 +52,7 @@ def render(mesh: ColoredMesh, azimuth: float = 30.0, elevation: float = 20.0,
     """Render ``mesh`` to an sRGB uint8 image of shape (H, W, 3), ``size`` = (W, H).
 
     ``border`` is the fraction of the smaller image side left empty around the mesh (at
-    least one pixel). ``light=False`` shows the interpolated vertex colours unshaded.
+    least one pixel). ``light=False`` shows the interpolated vertex colors unshaded.
     """
     w, h = int(size[0]), int(size[1])
     if w < 1 or h < 1:

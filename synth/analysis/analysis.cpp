@@ -11,7 +11,7 @@
 namespace solidtex {
 namespace {
 
-// Fits a PCA on N x N neighbourhoods sampled on a fixed lattice (at most ~4096 of them).
+// Fits a PCA on N x N neighborhoods sampled on a fixed lattice (at most ~4096 of them).
 Result<PcaBasis> fit_level_pca(const ImageF& stack, int n, int spacing, int out_dims) {
   const int64_t pixels = stack.pixel_count();
   const int stride = std::max(1, int(std::ceil(std::sqrt(double(pixels) / 4096.0))));

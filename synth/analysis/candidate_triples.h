@@ -1,7 +1,7 @@
 // Candidate coordinate triples of one pyramid level (Zhang §2; Dong et al. 2008).
 //
 // For every pixel p of every plane's exemplar we keep up to N_T triples T with T[plane] = p
-// whose three N x N neighbourhoods agree along their pairwise crossbars. Plane k's second
+// whose three N x N neighborhoods agree along their pairwise crossbars. Plane k's second
 // axis is plane k+1's first axis (types.h), so the three crossbars of T are
 //   second-axis line of plane k at T[k]  vs  first-axis line of plane k+1 at T[k+1],  k = 0,1,2,
 // each N samples at the level's spacing h. Search: the k-NN (FLANN) of p's second-axis line among

@@ -23,7 +23,7 @@ struct ExemplarInputs {
   std::optional<ImageF> yz, zx;       // both or neither; absent means "use xy for every plane"
   std::optional<ImageF> mask_xy;      // feature masks, same size as their exemplar
   std::optional<ImageF> mask_yz, mask_zx;  // required with yz/zx when mask_xy is given
-  float mask_weight = 1.0f;           // scale of the mask channel relative to colour, [0, 10]
+  float mask_weight = 1.0f;           // scale of the mask channel relative to color, [0, 10]
 };
 
 // Grain layouts (shared by `solidtex analyze --grain` and the service's `grain` parameter).

@@ -1,5 +1,5 @@
-// Sampling exemplar neighbourhoods and crossbar lines at a pyramid level's spacing h.
-// A neighbourhood of size N around pixel p holds, row-major, the pixels
+// Sampling exemplar neighborhoods and crossbar lines at a pyramid level's spacing h.
+// A neighborhood of size N around pixel p holds, row-major, the pixels
 // p + h*(i - N/2, j - N/2) for j, i in [0, N), each with all channels of the image.
 // Lines are the 1D pieces along one axis: kFirst varies the first coordinate (x of xy,
 // y of yz, z of zx), kSecond varies the second one.

@@ -1,4 +1,4 @@
-// Principal component analysis of neighbourhood vectors, to match in a small appearance
+// Principal component analysis of neighborhood vectors, to match in a small appearance
 // space (Zhang §4.3: about 20 dimensions per plane). Deterministic: samples are taken on a
 // fixed pixel lattice, eigenvectors are sign-normalised (largest |component| positive).
 #pragma once

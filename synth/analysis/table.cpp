@@ -39,7 +39,7 @@ Result<std::shared_ptr<const Table>> Table::assemble(AnalysisParams params, Exem
     for (int l = 0; l < L; ++l) {
       const PcaBasis& pca = pca_per_level[l][k];
       if (pca.input_dims != neighborhood_dims(params.neighborhood, img.channels))
-        return Status(StatusCode::kCorrupt, "PCA basis does not fit the neighbourhood size");
+        return Status(StatusCode::kCorrupt, "PCA basis does not fit the neighborhood size");
       const int spacing = stack_spacing(PyramidLevel{l}, L);
       auto app = std::make_shared<PlaneAppearance>();
       app->stack = std::move(stack[size_t(L - 1 - l)]);

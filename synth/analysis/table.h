@@ -4,7 +4,7 @@
 // Stored (in .stx): parameters, the matching images, per level and distinct image the PCA
 // basis, per level and plane the candidate triples, and per level the analysis statistics.
 // Derived on construction (not stored, reproduced bit for bit): Gaussian stacks and every
-// pixel's projected neighbourhood ("appearance vector").
+// pixel's projected neighborhood ("appearance vector").
 // Immutable once built; safe to share between threads.
 #pragma once
 
@@ -24,7 +24,7 @@ namespace solidtex {
 // One distinct exemplar image at one pyramid level.
 struct PlaneAppearance {
   ImageF stack;                   // Gaussian-stack matching image at this level's blur
-  PcaBasis pca;                   // fitted on N x N neighbourhoods at this level's spacing
+  PcaBasis pca;                   // fitted on N x N neighborhoods at this level's spacing
   std::vector<float> projected;   // width*height rows of pca.output_dims: appearance vectors
 
   const float* appearance(ExemplarPixel p) const {
@@ -57,7 +57,7 @@ class Table {
   std::vector<TableLevel> levels_;
 };
 
-// Projects every pixel's N x N neighbourhood of `stack` at `spacing` through `pca`.
+// Projects every pixel's N x N neighborhood of `stack` at `spacing` through `pca`.
 std::vector<float> project_all_neighborhoods(const ImageF& stack, const PcaBasis& pca, int n, int spacing);
 
 }  // namespace solidtex

@@ -7,7 +7,7 @@
 //            per level: analysis statistics, a PCA basis per distinct image, and candidate
 //            triples per searched plane (per pixel: a count, then for each triple the two
 //            coordinates of the *other* planes as u16 pairs; the pixel's own is implicit).
-// Stacks and projected neighbourhoods are not stored; Table::assemble reproduces them.
+// Stacks and projected neighborhoods are not stored; Table::assemble reproduces them.
 // Decoding checks magic, version, sizes and checksum before it trusts any field, and every
 // coordinate afterwards, so a damaged file is a clean kCorrupt / kVersionMismatch.
 #pragma once

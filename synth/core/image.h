@@ -1,5 +1,5 @@
 // A plain float image: the in-memory form of exemplars, masks, stacks and slices.
-// Pixels are interleaved, row-major, `channels` floats each. Colour images hold *linear* RGB.
+// Pixels are interleaved, row-major, `channels` floats each. Color images hold *linear* RGB.
 #pragma once
 
 #include <cstddef>

@@ -5,7 +5,7 @@
 //  - PNG, JPEG, TIFF and OpenEXR, detected from the bytes (never from a file name);
 //  - 8/16-bit integer and half/float pixels; 1 (gray), 2 (gray+alpha), 3 (RGB), 4 (RGBA) channels;
 //  - the result is always 3-channel *linear* float RGB: integer images are taken as sRGB
-//    unless they declare a linear colour space, float images as linear; gray is replicated,
+//    unless they declare a linear color space, float images as linear; gray is replicated,
 //    alpha is dropped;
 //  - dimensions are checked against ImageLimits from the header *before* pixels are decoded
 //    (OIIO 2.4 honours its own size limit only for TIFF).

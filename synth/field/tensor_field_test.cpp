@@ -80,7 +80,7 @@ TEST(TensorField, MalformedSketchesNameTheProblem) {
     std::string field;
   };
   const Case cases[] = {
-      {dom + R"({"points": [[1,1,1],[2,2,2]], "plane_normal": [0,0,1], "colour": 3}]})", "curves[0].colour"},
+      {dom + R"({"points": [[1,1,1],[2,2,2]], "plane_normal": [0,0,1], "color": 3}]})", "curves[0].color"},
       {dom + R"({"points": [[1,1,1],[1,1,1]], "plane_normal": [0,0,1]}]})", "curves[0].points[1]"},
       {dom + R"({"points": [[1,1,1],[1,1,5]], "plane_normal": [0,0,1]}]})", "curves[0].points[0]"},  // tangent || normal
       {dom + R"({"points": [[1,1,1],[20,2,2]], "plane_normal": [0,0,1]}]})", "curves[0].points[1]"},  // outside

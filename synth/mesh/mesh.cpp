@@ -63,17 +63,17 @@ int64_t bounding_voxels(const MeshBounds& bounds, const Placement& placement) {
 }
 
 std::vector<uint8_t> encode_ply(const Mesh& mesh, const std::vector<uint8_t>* srgb8) {
-  const bool colours = srgb8 && srgb8->size() == mesh.vertices.size() * 3;
+  const bool colors = srgb8 && srgb8->size() == mesh.vertices.size() * 3;
   std::string header = "ply\nformat binary_little_endian 1.0\ncomment solidtex\nelement vertex " +
                        std::to_string(mesh.vertices.size()) +
                        "\nproperty float x\nproperty float y\nproperty float z\n";
-  if (colours) header += "property uchar red\nproperty uchar green\nproperty uchar blue\n";
+  if (colors) header += "property uchar red\nproperty uchar green\nproperty uchar blue\n";
   header += "element face " + std::to_string(mesh.triangles.size()) + "\nproperty list uchar int vertex_indices\nend_header\n";
   ByteWriter w;
   w.bytes(std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(header.data()), header.size()));
   for (size_t i = 0; i < mesh.vertices.size(); ++i) {
     for (int a = 0; a < 3; ++a) w.f32(float(mesh.vertices[i][size_t(a)]));
-    if (colours)
+    if (colors)
       for (int c = 0; c < 3; ++c) w.u8((*srgb8)[i * 3 + size_t(c)]);
   }
   for (const auto& t : mesh.triangles) {

@@ -27,7 +27,7 @@ struct MeshLimits {
 struct MeshDefects {
   int64_t duplicate_faces = 0;        // dropped
   int64_t degenerate_faces = 0;       // dropped (a vertex repeated)
-  int64_t unreferenced_vertices = 0;  // kept (they still get colours)
+  int64_t unreferenced_vertices = 0;  // kept (they still get colors)
   int64_t boundary_edges = 0;         // edges of one triangle: holes
   int64_t non_manifold_edges = 0;     // edges of three or more triangles
   int64_t components = 0;             // connected by shared vertices

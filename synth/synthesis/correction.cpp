@@ -77,7 +77,7 @@ PlaneWeights normalised_weights(const std::array<float, 3>& w) {
   return {w[0] / total, w[1] / total, w[2] / total};
 }
 
-void matching_colour(const TableLevel& level, const CoordinateTriple& t, int channels, const PlaneWeights& w, float* out) {
+void matching_color(const TableLevel& level, const CoordinateTriple& t, int channels, const PlaneWeights& w, float* out) {
   const float* a = level.planes[0]->stack.wrapped(t.at[0].x, t.at[0].y);
   const float* b = level.planes[1]->stack.wrapped(t.at[1].x, t.at[1].y);
   const float* c = level.planes[2]->stack.wrapped(t.at[2].x, t.at[2].y);
@@ -85,7 +85,7 @@ void matching_colour(const TableLevel& level, const CoordinateTriple& t, int cha
   for (int k = channels; k < 4; ++k) out[k] = 0.f;
 }
 
-void output_colour(const Table& table, const CoordinateTriple& t, const PlaneWeights& w, float rgb[3]) {
+void output_color(const Table& table, const CoordinateTriple& t, const PlaneWeights& w, float rgb[3]) {
   const ExemplarSet& e = table.exemplars();
   const float* a = e.plane(Plane::kXY).wrapped(t.at[0].x, t.at[0].y);
   const float* b = e.plane(Plane::kYZ).wrapped(t.at[1].x, t.at[1].y);
@@ -98,7 +98,7 @@ CorrectionContext CorrectionContext::make(const Table& table, PyramidLevel l, co
   CorrectionContext ctx;
   ctx.candidates_per_source = coherent_matcher ? 4 : 64;
   ctx.cost_weights = plane_weights;
-  ctx.colour_weights = normalised_weights(plane_weights);
+  ctx.color_weights = normalised_weights(plane_weights);
   ctx.level = &table.level(l);
   ctx.n = table.params().neighborhood;
   ctx.spacing = table.spacing(l);

@@ -5,7 +5,7 @@
 // exactly the same offsets. Both call build_stencil() with the same rotation, so reads and
 // dependency sets agree bit for bit (checked by the instrumented synthesis test).
 //
-// Neighbourhoods: for plane k with exemplar axes (first, second) and offsets i, j in
+// Neighborhoods: for plane k with exemplar axes (first, second) and offsets i, j in
 // [-N/2, N/2], the local offset has `i` on the plane's first axis and `j` on its second
 // (xy: (i,j,0), yz: (0,i,j), zx: (j,0,i)); the world sample is p + R * local, in voxels of
 // the level. Trilinear levels blend the 8 surrounding voxels (corners of weight exactly 0 are
@@ -18,9 +18,9 @@
 // planes of squared distances to its stored appearance vectors. Lowest cost wins; equal costs
 // go to the lexicographically smallest triple. No randomness, fixed summation order.
 //
-// Voxel colour: the matching colour of a triple is the mean over the three planes of that
-// level's Gaussian-stack colour at T_k (RGB plus mask channel), weighted by the plane weights;
-// the output colour of a finest-level voxel is the same mean over the original exemplars' RGB.
+// Voxel color: the matching color of a triple is the mean over the three planes of that
+// level's Gaussian-stack color at T_k (RGB plus mask channel), weighted by the plane weights;
+// the output color of a finest-level voxel is the same mean over the original exemplars' RGB.
 #pragma once
 
 #include <array>
@@ -36,7 +36,7 @@ namespace solidtex {
 
 struct VoxelState {
   CoordinateTriple triple;
-  std::array<float, 4> colour{};  // matching colour; channels beyond the table's are 0
+  std::array<float, 4> color{};  // matching color; channels beyond the table's are 0
 };
 
 struct Tap {
@@ -57,11 +57,11 @@ void build_stencil(const Rot3& r, int n, bool trilinear, ReadStencil& out);
 // Every distinct voxel offset the stencil reads, in a fixed order.
 void stencil_offsets(const ReadStencil& s, std::vector<std::array<int8_t, 3>>& out);
 
-// Colours are weighted means over the planes (weights normalised to sum to 1).
+// Colors are weighted means over the planes (weights normalised to sum to 1).
 using PlaneWeights = std::array<float, 3>;
 PlaneWeights normalised_weights(const std::array<float, 3>& w);
-void matching_colour(const TableLevel& level, const CoordinateTriple& t, int channels, const PlaneWeights& w, float* out);
-void output_colour(const Table& table, const CoordinateTriple& t, const PlaneWeights& w, float rgb[3]);
+void matching_color(const TableLevel& level, const CoordinateTriple& t, int channels, const PlaneWeights& w, float* out);
+void output_color(const Table& table, const CoordinateTriple& t, const PlaneWeights& w, float rgb[3]);
 
 // Per-level constants of the correction, precomputed once per synthesizer.
 struct CorrectionContext {
@@ -74,7 +74,7 @@ struct CorrectionContext {
   std::array<const float*, 3> mean{};
   PlaneWeights cost_weights{1.f, 1.f, 1.f};          // per-plane matching weights
   int candidates_per_source = 64;                    // table candidates tried per source pixel
-  PlaneWeights colour_weights{1.f / 3, 1.f / 3, 1.f / 3};
+  PlaneWeights color_weights{1.f / 3, 1.f / 3, 1.f / 3};
   static CorrectionContext make(const Table& table, PyramidLevel l, const std::array<float, 3>& plane_weights,
                                 bool coherent_matcher);
 };
@@ -104,7 +104,7 @@ CoordinateTriple correct_voxel(const CorrectionContext& ctx, const ReadStencil& 
     for (int t = st.begin[q]; t < st.begin[q + 1]; ++t) {
       const Tap& tap = st.taps[size_t(t)];
       const VoxelState& v = read(tap.dx, tap.dy, tap.dz);
-      for (int k = 0; k < c; ++k) acc[k] += tap.weight * v.colour[size_t(k)];
+      for (int k = 0; k < c; ++k) acc[k] += tap.weight * v.color[size_t(k)];
     }
     for (int k = 0; k < c; ++k) *g++ = acc[k];
   }

@@ -54,7 +54,7 @@ LevelSchedule LevelSchedule::make(int level, const SynthesisParams& params) {
   LevelSchedule s;
   const bool coarsest = level == 0;
   const int passes = coarsest ? params.coarse_passes : params.passes;
-  const bool plain = coarsest || params.scheme == Scheme::kStandard;
+  const bool plain = coarsest || params.scheme == Scheme::kPlain;
   s.s_ = plain ? 1 : params.subpass_size;
   const int classes = s.s_ == 1 ? 1 : 8;
   const CellLattice primary{params.cell_size, 0};

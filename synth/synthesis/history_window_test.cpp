@@ -60,7 +60,7 @@ TEST(LevelSchedule, DualGridStepsSlotsAndBarriers) {
   const LevelSchedule coarse = LevelSchedule::make(0, p);
   EXPECT_EQ(coarse.final_version(), 3);
   for (const auto& s : coarse.steps()) EXPECT_FALSE(s.window.has_barrier());
-  p.scheme = Scheme::kStandard;
+  p.scheme = Scheme::kPlain;
   EXPECT_EQ(LevelSchedule::make(2, p).final_version(), 2);
 }
 

@@ -34,9 +34,9 @@ class LevelStore {
 
   // The 3x3x3 bricks around voxel p, looked up once, so that reads at offsets up to +-8
   // cost no table lookups. Missing bricks are null.
-  class Neighbourhood {
+  class Neighborhood {
    public:
-    Neighbourhood(const LevelStore& store, const Voxel& p) : p_(p), slots_(store.slots_) {
+    Neighborhood(const LevelStore& store, const Voxel& p) : p_(p), slots_(store.slots_) {
       for (int z = -1; z <= 1; ++z)
         for (int y = -1; y <= 1; ++y)
           for (int x = -1; x <= 1; ++x) {

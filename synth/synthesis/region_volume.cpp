@@ -66,17 +66,17 @@ Result<std::vector<std::array<float, 3>>> RegionVolume::synthesize(const TargetS
     where[i] = {k, uint32_t(parts[size_t(k)].size())};
     parts[size_t(k)].push_back(v);
   }
-  std::vector<std::vector<std::array<float, 3>>> colours(regions_.size());
+  std::vector<std::vector<std::array<float, 3>>> colors(regions_.size());
   if (stats) stats->assign(regions_.size(), SynthesisStats{});
   for (size_t k = 0; k < regions_.size(); ++k) {
     if (parts[k].empty()) continue;
     const TargetSet sub = TargetSet::from_voxels(parts[k], int(parts[k].size()), 1);
-    SOLIDTEX_ASSIGN_OR_RETURN(colours[k], regions_[k]->synthesize(sub, interrupter, stats ? &(*stats)[k] : nullptr));
+    SOLIDTEX_ASSIGN_OR_RETURN(colors[k], regions_[k]->synthesize(sub, interrupter, stats ? &(*stats)[k] : nullptr));
   }
   std::vector<std::array<float, 3>> out(target.sample.size());
   for (size_t s = 0; s < target.sample.size(); ++s) {
     const auto& [k, idx] = where[target.sample[s]];
-    out[s] = colours[size_t(k)][idx];
+    out[s] = colors[size_t(k)][idx];
   }
   return out;
 }

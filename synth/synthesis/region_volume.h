@@ -1,7 +1,7 @@
 // Per-region exemplars (Zhang Fig. 15; Gorla's multitexturing): a volume made of several
 // solid textures, one per region, with a label function choosing the region of each finest
 // voxel (by its centre). Each region is synthesized by its own Synthesizer as if it filled
-// space, and a voxel takes the colour of its region's texture. So every voxel, including those
+// space, and a voxel takes the color of its region's texture. So every voxel, including those
 // next to a region boundary, is exactly what its region's synthesizer alone gives: spatially
 // deterministic, whatever the request. Thread-safe like Synthesizer.
 #pragma once

@@ -3,11 +3,16 @@
 namespace solidtex {
 
 Result<Scheme> parse_scheme(const std::string& name) {
-  if (name == "standard") return Scheme::kStandard;
+  if (name == "plain") return Scheme::kPlain;
+  if (name == "standard")  // renamed: the paper's standard scheme is the one with subpasses
+    return Status(StatusCode::kInvalidArgument,
+                  "scheme 'standard' was renamed 'plain' (plain passes without subpasses); the paper's "
+                  "standard scheme is 'subpass'",
+                  "scheme");
   if (name == "subpass") return Scheme::kSubpass;
   if (name == "grid") return Scheme::kGrid;
   if (name == "dual-grid") return Scheme::kDualGrid;
-  return Status(StatusCode::kInvalidArgument, "unknown scheme '" + name + "' (standard, subpass, grid, dual-grid)", "scheme");
+  return Status(StatusCode::kInvalidArgument, "unknown scheme '" + name + "' (plain, subpass, grid, dual-grid)", "scheme");
 }
 
 Result<Matcher> parse_matcher(const std::string& name) {
@@ -20,7 +25,7 @@ const char* matcher_name(Matcher m) { return m == Matcher::kPaper ? "paper" : "c
 
 const char* scheme_name(Scheme s) {
   switch (s) {
-    case Scheme::kStandard: return "standard";
+    case Scheme::kPlain: return "plain";
     case Scheme::kSubpass: return "subpass";
     case Scheme::kGrid: return "grid";
     case Scheme::kDualGrid: return "dual-grid";

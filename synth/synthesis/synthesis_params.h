@@ -19,7 +19,7 @@ Result<Matcher> parse_matcher(const std::string& name);
 const char* matcher_name(Matcher m);
 
 enum class Scheme {
-  kStandard,  // P plain passes, every voxel updated per step, no barriers
+  kPlain,     // P plain passes, every voxel updated per step, no barriers
   kSubpass,   // P passes of s^3 subpasses, no barriers (Lefebvre-Hoppe / Dong et al.)
   kGrid,      // subpasses + grid barriers: outside p's M^3 cell, read version 0
   kDualGrid,  // ceil(P/2) grid passes, then floor(P/2) passes on cells shifted by M/2 whose
@@ -37,9 +37,9 @@ struct SynthesisParams {
   int subpass_size = 2;      // s: s^3 subpasses per pass for subpass/grid schemes, {1, 2}
   int cell_size = 12;        // M: grid cell side in voxels of the level, [4, 64]
   int init_subpart = 32;     // K: coarsest-level voxels per initialisation subpart side, even, [8, 256]
-  int trilinear_levels = 2;  // the coarsest this-many levels sample neighbourhoods trilinearly, [0, 8]
+  int trilinear_levels = 2;  // the coarsest this-many levels sample neighborhoods trilinearly, [0, 8]
   uint32_t seed = 1;         // hashed with (voxel, level) wherever synthesis needs randomness
-  // Relative weight of each plane (xy, yz, zx) in matching costs and voxel colours, [0, 1],
+  // Relative weight of each plane (xy, yz, zx) in matching costs and voxel colors, [0, 1],
   // not all zero. Zhang §6.1: a plane whose exemplar conflicts with the others in 3D (e.g.
   // the end grain of a wood exemplar) is best given a small weight.
   std::array<float, 3> plane_weights{1.f, 1.f, 1.f};

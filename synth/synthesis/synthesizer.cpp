@@ -173,7 +173,7 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize(const TargetSe
         store.allocate(p);
         VoxelState& s = store.at(p, sch.slot(p, V));
         s.triple = cached[i];
-        matching_colour(*impl.contexts[size_t(l)].level, s.triple, channels, impl.contexts[size_t(l)].colour_weights, s.colour.data());
+        matching_color(*impl.contexts[size_t(l)].level, s.triple, channels, impl.contexts[size_t(l)].color_weights, s.color.data());
         store.set_flag(p, sch.slot(p, V), LevelStore::kRequired);
         cache_hits[size_t(l)].push_back(p);
       } else {
@@ -295,7 +295,7 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize(const TargetSe
           }
           s.triple = upsample_triple(table, PyramidLevel{l}, p, parent_store->at(P, pslot).triple, rotation(l - 1, P));
         }
-        matching_colour(*ctx.level, s.triple, channels, ctx.colour_weights, s.colour.data());
+        matching_color(*ctx.level, s.triple, channels, ctx.color_weights, s.color.data());
       }
     });
     if (l > 0) {
@@ -323,7 +323,7 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize(const TargetSe
             st = &local;
           }
           const HistoryWindow::Resolved window = step.window.resolve(p);
-          const LevelStore::Neighbourhood near(store, p);
+          const LevelStore::Neighborhood near(store, p);
           auto read = [&](int dx, int dy, int dz) -> const VoxelState& {
             const Voxel q{p.x + dx, p.y + dy, p.z + dz};
             const int slot = sch.slot(q, window.version_of(q));
@@ -338,7 +338,7 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize(const TargetSe
           };
           VoxelState& out = store.at(p, sch.slot(p, v));
           out.triple = correct_voxel(ctx, *st, read, scratch);
-          matching_colour(*ctx.level, out.triple, channels, ctx.colour_weights, out.colour.data());
+          matching_color(*ctx.level, out.triple, channels, ctx.color_weights, out.color.data());
         }
       });
     }
@@ -354,7 +354,7 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize(const TargetSe
     stats.levels[size_t(l)].seconds = since(t_level);
   }
 
-  // Output colours.
+  // Output colors.
   const int fl = L - 1;
   const LevelSchedule& fsch = schedules_[size_t(fl)];
   LevelStore& fstore = *stores[size_t(fl)];
@@ -363,7 +363,7 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize(const TargetSe
     const Voxel& p = target.voxels[i];
     const int slot = fsch.slot(p, fsch.final_version());
     if (options.instrument) fstore.set_flag(p, slot, LevelStore::kRead);
-    output_colour(table, fstore.at(p, slot).triple, impl.contexts[size_t(fl)].colour_weights, voxel_rgb[i].data());
+    output_color(table, fstore.at(p, slot).triple, impl.contexts[size_t(fl)].color_weights, voxel_rgb[i].data());
   }
   check_tightness(fl);
   std::vector<std::array<float, 3>> out(target.sample.size());

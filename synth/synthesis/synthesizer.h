@@ -53,7 +53,7 @@ struct SynthesisOptions {
   bool instrument = false;  // check soundness and tightness of the dependency sets
   bool use_cache = true;    // consult and fill the VoxelCache
   // Compute the dependency sets and their sizes only (stats), synthesize nothing; the
-  // returned colours are then empty. For measuring schemes at sizes too big to synthesize.
+  // returned colors are then empty. For measuring schemes at sizes too big to synthesize.
   bool dependencies_only = false;
 };
 

@@ -137,7 +137,7 @@ TEST_F(SynthesizerTest, PlaneCutsAndPointsMatchAxisCuts) {
 }
 
 TEST_F(SynthesizerTest, DependencySetsAreSoundAndTightForEveryScheme) {
-  for (Scheme scheme : {Scheme::kStandard, Scheme::kSubpass, Scheme::kGrid, Scheme::kDualGrid}) {
+  for (Scheme scheme : {Scheme::kPlain, Scheme::kSubpass, Scheme::kGrid, Scheme::kDualGrid}) {
     for (const char* field : {"identity", "axis:1,2,3,37"}) {
       SCOPED_TRACE(std::string(scheme_name(scheme)) + " " + field);
       SynthesisParams p = small_params(scheme);
@@ -198,7 +198,7 @@ TEST_F(SynthesizerTest, CorrectionLowersMatchingEnergyAndDualGridKeepsQuality) {
     auto s = make(table_, "identity", p, 0);
     double e = 0;
     for (char axis : {'x', 'y', 'z'}) {
-      const double ea = neighbourhood_energy(to_image(cut(*s, axis, 5, 0, 0, 40, 40), 40, 40), exemplar, 7, 2);
+      const double ea = neighborhood_energy(to_image(cut(*s, axis, 5, 0, 0, 40, 40), 40, 40), exemplar, 7, 2);
       e += ea / 3;
     }
     return e;

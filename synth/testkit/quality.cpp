@@ -66,7 +66,7 @@ double dominant_period_x(const ImageF& img) {
   return double(w) / peak;
 }
 
-double neighbourhood_energy(const ImageF& cut, const ImageF& exemplar, int n, int stride) {
+double neighborhood_energy(const ImageF& cut, const ImageF& exemplar, int n, int stride) {
   const int dims = neighborhood_dims(n, exemplar.channels);
   std::vector<float> ex(size_t(exemplar.pixel_count()) * dims);
   for (int y = 0; y < exemplar.height; ++y)

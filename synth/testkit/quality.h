@@ -13,9 +13,9 @@ double dominant_orientation_degrees(const ImageF& image);
 // removed), refined by parabolic interpolation between frequency bins (>= 2 cycles).
 double dominant_period_x(const ImageF& image);
 
-// Neighbourhood-matching energy: the mean, over every N x N neighbourhood that fits inside
+// Neighborhood-matching energy: the mean, over every N x N neighborhood that fits inside
 // `cut` (taken every `stride` pixels), of the squared distance per element to its nearest
-// neighbourhood of `exemplar` (toroidal). Lower means the cut looks more like the exemplar.
-double neighbourhood_energy(const ImageF& cut, const ImageF& exemplar, int n, int stride = 1);
+// neighborhood of `exemplar` (toroidal). Lower means the cut looks more like the exemplar.
+double neighborhood_energy(const ImageF& cut, const ImageF& exemplar, int n, int stride = 1);
 
 }  // namespace solidtex

@@ -42,7 +42,7 @@ def test_malformed_json(err):
 def test_bad_volume_specs_name_the_key(err):
     url = err.url + "/v1/volumes"
     cases = [
-        ({"exemplar": err.exemplar_id, "colour": "red"}, "colour"),
+        ({"exemplar": err.exemplar_id, "color": "red"}, "color"),
         ({"exemplar": err.exemplar_id, "params": {"shceme": "grid"}}, "shceme"),
         ({"exemplar": err.exemplar_id, "params": {"scheme": "bogus"}}, "scheme"),
         ({"exemplar": err.exemplar_id, "seed": -1}, "seed"),
@@ -53,8 +53,8 @@ def test_bad_volume_specs_name_the_key(err):
         assert_error(requests.post(url, json=body, timeout=30), 400, "invalid_argument",
                      field_contains=key)
     with pytest.raises(BadRequest) as info:
-        err.client.create_volume({"exemplar": err.exemplar_id, "colour": "red"})
-    assert info.value.status == 400 and "colour" in info.value.field
+        err.client.create_volume({"exemplar": err.exemplar_id, "color": "red"})
+    assert info.value.status == 400 and "color" in info.value.field
 
 
 def test_bad_query_parameters(err, exemplars):
@@ -76,7 +76,7 @@ def test_bad_query_parameters(err, exemplars):
     png = exemplars["wood"].read_bytes()
     n_before = len(err.client.list_exemplars())
     for params, key in (({"levels": "99"}, "levels"), ({"neighborhood": "4"}, "neighborhood"),
-                        ({**ANALYSIS, "colour": "red"}, "colour"),
+                        ({**ANALYSIS, "color": "red"}, "color"),
                         ({**ANALYSIS, "plane_weights": "1,2"}, "plane_weights")):
         r = requests.post(err.url + "/v1/exemplars", params=params, data=png,
                           headers={"Content-Type": "application/octet-stream"}, timeout=30)

@@ -90,10 +90,10 @@ def test_malformed_sketches(shared):
     assert_error(requests.post(url, json=one_point, timeout=60), 400, "invalid_argument",
                  field_contains="curves[0]")
     unknown = copy.deepcopy(SKETCH)
-    unknown["curves"][0]["colour"] = "red"
+    unknown["curves"][0]["color"] = "red"
     err = assert_error(requests.post(url, json=unknown, timeout=60), 400, "invalid_argument",
                        field_contains="curves[0]")
-    assert "colour" in err["field"] + err["message"]
+    assert "color" in err["field"] + err["message"]
     no_curves = {"domain": SKETCH["domain"]}
     assert_error(requests.post(url, json=no_curves, timeout=60), 400, "invalid_argument",
                  field_contains="curves")

@@ -1,5 +1,5 @@
 """Grain follows a curvature-derived field: on a cylinder, principal-curvature frames put the
-grain (frame x) along the axis, so a striped exemplar's stripes run along the axis: colours
+grain (frame x) along the axis, so a striped exemplar's stripes run along the axis: colors
 change slowly along it and quickly around it. With the identity field (grain along world x,
 across the z-axis cylinder) the same measure is clearly worse."""
 import numpy as np
@@ -44,7 +44,7 @@ def test_curvature_field_turns_the_grain_along_a_cylinder(server, exemplars):
     assert r.status_code == 201, r.text
     field = r.json()["id"]
 
-    def colours(field_spec):
+    def colors(field_spec):
         spec = {"exemplar": ex["exemplar"]["id"], "seed": 5}
         if field_spec:
             spec["field"] = field_spec
@@ -54,8 +54,8 @@ def test_curvature_field_turns_the_grain_along_a_cylinder(server, exemplars):
         assert r.status_code == 200, r.text
         return np.asarray(r.json()["colors"], dtype=np.float64)
 
-    with_field = along_over_around(colours({"id": field}))
-    identity = along_over_around(colours(None))
-    print(f"along/around colour change: curvature field {with_field:.3f}, identity {identity:.3f}")
+    with_field = along_over_around(colors({"id": field}))
+    identity = along_over_around(colors(None))
+    print(f"along/around color change: curvature field {with_field:.3f}, identity {identity:.3f}")
     assert with_field < 0.6, with_field
     assert with_field < 0.7 * identity, (with_field, identity)

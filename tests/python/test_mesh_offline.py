@@ -1,4 +1,4 @@
-"""Coloured-PLY parsing, the software renderer and the mesh client methods, without a server."""
+"""Colored-PLY parsing, the software renderer and the mesh client methods, without a server."""
 import json
 import time
 from urllib.parse import parse_qs, urlsplit
@@ -133,7 +133,7 @@ def test_render_uniform_square_centre_and_border():
     assert not obj[:, :3].any() and not obj[:, -3:].any()
 
 
-def test_render_interpolates_colours():
+def test_render_interpolates_colors():
     # red on the left (x = 0), blue on the right (x = 1)
     mesh = merge(square([[255, 0, 0], [0, 0, 255], [0, 0, 255], [255, 0, 0]]))
     img = render(mesh, azimuth=0, elevation=0, size=(41, 41), light=False).astype(int)

@@ -32,14 +32,14 @@ def test_surface_shell_takes_the_second_texture_near_the_surface(server, exempla
     only_spots = c.create_volume(exemplar=spots, seed=3)["id"]
 
     # Every vertex lies on the surface, so inside the shell: the spots texture.
-    def colours(vol):
+    def colors(vol):
         r = requests.post(f"{srv.url}/v1/volumes/{vol}/surface",
                           json={"mesh": mesh, "placement": placement, "format": "json"}, timeout=300)
         assert r.status_code == 200, r.text
         return np.asarray(r.json()["colors"], dtype=np.float32)
 
-    assert np.array_equal(colours(shell), colours(only_spots))
-    assert not np.array_equal(colours(shell), colours(only_wood))
+    assert np.array_equal(colors(shell), colors(only_spots))
+    assert not np.array_equal(colors(shell), colors(only_wood))
 
     # A z-slice through the middle has both: far from the surface the wood texture, bit for bit.
     def cut(vol):

@@ -204,14 +204,14 @@ def test_shared_mesh_uploads_and_textures(env, name):
     assert np.all(colored.vertices.min(0) >= lo - 1e-5 * size.max())
     assert np.all(colored.vertices.max(0) <= hi + 1e-5 * size.max())
     assert np.allclose(colored.vertices.min(0), lo, atol=1e-5 * size.max())
-    assert len(np.unique(colored.colors, axis=0)) > 1, "all vertices have one colour"
+    assert len(np.unique(colored.colors, axis=0)) > 1, "all vertices have one color"
     target = colored.header_int("X-Target-Voxels")
     assert 0 < target <= mesh["vertices"]
     assert colored.header_int("X-Bounding-Voxels") >= target
     assert colored.header_int("X-Voxels-Synthesized") >= 0
 
 
-# -- colours: exactly the points answer at the placed vertex ---------------------------------
+# -- colors: exactly the points answer at the placed vertex ---------------------------------
 
 
 def test_placement_follows_the_contract(env):
@@ -230,7 +230,7 @@ def test_placement_follows_the_contract(env):
 
 
 @pytest.mark.parametrize("name", ["bunny.off", "horse.ply"])
-def test_vertex_colours_are_the_points_answer(env, name):
+def test_vertex_colors_are_the_points_answer(env, name):
     c, vol = env.client, env.volume_id
     mesh = stored(env, name)
     out = c.surface(vol, mesh_id=mesh["id"], placement=PLACE, fmt="json")
@@ -238,23 +238,23 @@ def test_vertex_colours_are_the_points_answer(env, name):
     assert out["vertices"] == mesh["vertices"] and colors.shape == (mesh["vertices"], 3)
     assert colors.dtype == np.float32 and np.all(np.isfinite(colors))
     ply = c.surface(vol, mesh_id=mesh["id"], placement=PLACE)
-    # the PLY's sRGB8 colours are the JSON's linear colours, encoded
+    # the PLY's sRGB8 colors are the JSON's linear colors, encoded
     assert np.abs(ply.colors.astype(float) - srgb8(colors)).max() <= 1
 
     _, voxels, ambiguous = placed(ply.vertices, out["placement"])
     print(f"{name}: {ambiguous.sum()} of {len(voxels)} vertices within 1e-3 of a rounding tie")
     assert ambiguous.mean() < 0.03
     want = c.points(vol, voxels[~ambiguous])
-    assert_bits_equal(colors[~ambiguous], want, f"{name}: surface colours vs points")
+    assert_bits_equal(colors[~ambiguous], want, f"{name}: surface colors vs points")
 
-    # an explicit placement equal to the returned one gives the same colours
+    # an explicit placement equal to the returned one gives the same colors
     explicit = {"scale": out["placement"]["scale"], "translate": out["placement"]["translate"]}
     again = c.surface(vol, mesh_id=mesh["id"], placement=explicit, fmt="json")
     assert math.isclose(again["placement"]["scale"], explicit["scale"], rel_tol=1e-15)
     assert_bits_equal(again["colors"], colors, f"{name}: explicit placement")
 
 
-def test_extra_points_are_coloured_like_points(env):
+def test_extra_points_are_colored_like_points(env):
     c, vol = env.client, env.volume_id
     mesh = stored(env, "bunny.off")
     ply = c.surface(vol, mesh_id=mesh["id"], placement=PLACE)
@@ -290,7 +290,7 @@ def test_raw_mesh_body_matches_stored_mesh(env):
     assert np.array_equal(parse_colored_ply(r.content).colors, ply_id.colors)
 
 
-def test_surface_stats_dual_grid_and_standard(env):
+def test_surface_stats_dual_grid_and_plain(env):
     """Fresh volumes (nothing cached) for two schemes at two resolutions. The target is at
     most one voxel per vertex, and the voxels synthesized (dependent sets over all levels)
     grow far slower than the bounding box, so the fraction falls with the resolution.
@@ -299,7 +299,7 @@ def test_surface_stats_dual_grid_and_standard(env):
     c = env.client
     mesh = stored(env, "bunny.off")
     results = {}
-    for scheme in ("dual-grid", "standard"):
+    for scheme in ("dual-grid", "plain"):
         for res in RES_STATS:
             vol = c.create_volume({"exemplar": env.exemplar_id, "seed": SEED,
                                    "params": {"scheme": scheme}})
@@ -324,11 +324,11 @@ def test_surface_stats_dual_grid_and_standard(env):
             results[scheme, res] = st
     lo, hi = RES_STATS
     for res in RES_STATS:
-        assert results["dual-grid", res]["target_voxels"] == results["standard", res]["target_voxels"]
-    for scheme in ("dual-grid", "standard"):
+        assert results["dual-grid", res]["target_voxels"] == results["plain", res]["target_voxels"]
+    for scheme in ("dual-grid", "plain"):
         assert results[scheme, hi]["fraction"] < 0.7 * results[scheme, lo]["fraction"], \
             (scheme, results[scheme, lo], results[scheme, hi])
-    assert results["standard", hi]["fraction"] < 0.5, results["standard", hi]
+    assert results["plain", hi]["fraction"] < 0.5, results["plain", hi]
 
 
 # -- errors --------------------------------------------------------------------------------
@@ -420,7 +420,7 @@ def test_mesh_lifecycle_and_not_found(env):
     ({"mesh": "M", "placement": {"scale": 0, "translate": [0, 0, 0]}}, "scale"),
     ({"mesh": "M", "placement": {"margin": 2}}, "margin"),
     ({"mesh": "M", "format": "obj"}, "format"),
-    ({"mesh": "M", "colour": "red"}, "colour"),
+    ({"mesh": "M", "color": "red"}, "color"),
     ({"mesh": "M", "placement": {"scale": 1, "translate": [0, 0]}}, "translate"),
     ({"mesh": "M", "format": "json", "points": [[0, 0]]}, "points"),
 ])
@@ -514,7 +514,7 @@ def test_render_command_writes_a_textured_view(env, tmp_path):
     mean_pixel = px[obj].astype(float).mean(axis=0)
     distinct = len(np.unique(px[obj], axis=0))
     print(f"render: coverage {coverage:.3f}, mean pixel {mean_pixel.round(1)}, mean vertex "
-          f"{mean_vertex.round(1)}, {distinct} colours; stdout {proc.stdout.strip()}")
+          f"{mean_vertex.round(1)}, {distinct} colors; stdout {proc.stdout.strip()}")
     assert 0.1 <= coverage <= 0.9
     assert np.all(np.abs(mean_pixel - mean_vertex) <= 60), (mean_pixel, mean_vertex)
     assert distinct >= 20
