@@ -13,8 +13,6 @@ namespace solidtex {
 namespace {
 
 // Axes (0 = x, 1 = y, 2 = z) of each plane's first and second coordinate.
-constexpr int kFirstAxis[3] = {0, 1, 2};
-constexpr int kSecondAxis[3] = {1, 2, 0};
 
 // Crossbar line vectors of one image: row i holds pixel i's line.
 struct LineSet {
@@ -49,23 +47,6 @@ float sq_dist(const float* a, const float* b, int dims) {
 
 ExemplarPixel pixel_of(int index, int width) { return {index % width, index / width}; }
 
-CoordinateTriple wrap_triple(CoordinateTriple t, const PlaneStacks& stacks) {
-  for (int k = 0; k < 3; ++k) {
-    t.at[k].x = ImageF::wrap(t.at[k].x, stacks[k]->width);
-    t.at[k].y = ImageF::wrap(t.at[k].y, stacks[k]->height);
-  }
-  return t;
-}
-
-// Eq. 4: moving by a 3D step d moves plane j's coordinate by (d[first_j], d[second_j]).
-CoordinateTriple shift_triple(const CoordinateTriple& t, const int d[3]) {
-  CoordinateTriple out = t;
-  for (int j = 0; j < 3; ++j) {
-    out.at[j].x += d[kFirstAxis[j]];
-    out.at[j].y += d[kSecondAxis[j]];
-  }
-  return out;
-}
 
 struct Scored {
   float error;
@@ -216,7 +197,7 @@ Result<LevelCandidates> compute_level_candidates(const PlaneStacks& stacks, bool
     pc.per_pixel = nt;
     pc.triples.assign(size_t(img.pixel_count()) * nt, CoordinateTriple{});
     pc.counts.assign(size_t(img.pixel_count()), 0);
-    const int fa = kFirstAxis[k], sa = kSecondAxis[k];
+    const int fa = kPlaneFirstAxis[size_t(k)], sa = kPlaneSecondAxis[size_t(k)];
     tbb::parallel_for(tbb::blocked_range<int>(0, img.height), [&](const tbb::blocked_range<int>& rows) {
       std::vector<Scored> chosen;
       std::vector<char> coherent;
@@ -232,7 +213,7 @@ Result<LevelCandidates> compute_level_candidates(const PlaneStacks& stacks, bool
               int d[3] = {0, 0, 0};
               d[fa] = dl[0] * spacing;
               d[sa] = dl[1] * spacing;
-              const CoordinateTriple want = wrap_triple(shift_triple(mine[i].t, d), stacks);
+              const CoordinateTriple want = shift_triple(mine[i].t, d, stacks);
               const size_t q = size_t(ImageF::wrap(y + dl[1] * spacing, img.height)) * img.width +
                                ImageF::wrap(x + dl[0] * spacing, img.width);
               const Scored* theirs = &raw[k][q * keep];

@@ -6,21 +6,26 @@
 
 namespace solidtex {
 
-void PcaBasis::project(const float* in, float* out) const {
-  // Centre once, then one dot product per output in a fixed order.
-  float centred[1024];
-  std::vector<float> heap;
-  float* c = centred;
-  if (input_dims > 1024) {
-    heap.resize(input_dims);
-    c = heap.data();
-  }
-  for (int i = 0; i < input_dims; ++i) c[i] = in[i] - mean[i];
-  for (int r = 0; r < output_dims; ++r) {
-    const float* b = &basis[size_t(r) * input_dims];
-    float s = 0.f;
-    for (int i = 0; i < input_dims; ++i) s += b[i] * c[i];
-    out[r] = s;
+PcaProjection PcaProjection::of(const PcaBasis& b) {
+  PcaProjection p;
+  p.input_dims = b.input_dims;
+  p.output_dims = b.output_dims;
+  p.mean = b.mean;
+  p.basis_t.resize(size_t(b.input_dims) * b.output_dims);
+  for (int r = 0; r < b.output_dims; ++r)
+    for (int i = 0; i < b.input_dims; ++i) p.basis_t[size_t(i) * b.output_dims + r] = b.basis[size_t(r) * b.input_dims + i];
+  return p;
+}
+
+// Lane-wise identical whatever the vector width (no FMA, no reassociation), so the AVX2 and
+// baseline clones give the same bits.
+__attribute__((target_clones("avx2", "default"))) void PcaProjection::project(const float* in, float* out) const {
+  const int d = output_dims;
+  for (int r = 0; r < d; ++r) out[r] = 0.f;
+  for (int i = 0; i < input_dims; ++i) {
+    const float centred = in[i] - mean[size_t(i)];
+    const float* row = basis_t.data() + size_t(i) * d;
+    for (int r = 0; r < d; ++r) out[r] += row[r] * centred;  // independent accumulators: vectorises
   }
 }
 

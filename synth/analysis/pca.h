@@ -14,10 +14,21 @@ struct PcaBasis {
   int output_dims = 0;
   std::vector<float> mean;   // input_dims
   std::vector<float> basis;  // output_dims rows of input_dims, most significant first
-
-  // out[r] = basis_r . (in - mean); fixed summation order.
-  void project(const float* in, float* out) const;
   friend bool operator==(const PcaBasis&, const PcaBasis&) = default;
+};
+
+// The one projection into appearance space (analysis and synthesis both use it):
+// out[r] = sum over i ascending of basis_r[i] * (in[i] - mean[i]). The basis is kept
+// transposed (input-major) so each input feeds output_dims independent accumulators, which
+// vectorise; the order per output is fixed, so every build and clone gives the same bits.
+struct PcaProjection {
+  int input_dims = 0;
+  int output_dims = 0;
+  std::vector<float> mean;     // input_dims
+  std::vector<float> basis_t;  // input_dims rows of output_dims
+
+  static PcaProjection of(const PcaBasis& b);
+  void project(const float* in, float* out) const;
 };
 
 // `samples` holds `count` vectors of `dims` floats. output_dims is clamped to dims.

@@ -8,7 +8,8 @@
 
 namespace solidtex {
 
-std::vector<float> project_all_neighborhoods(const ImageF& stack, const PcaBasis& pca, int n, int spacing) {
+std::vector<float> project_all_neighborhoods(const ImageF& stack, const PcaBasis& basis, int n, int spacing) {
+  const PcaProjection pca = PcaProjection::of(basis);
   std::vector<float> out(size_t(stack.pixel_count()) * pca.output_dims);
   tbb::parallel_for(tbb::blocked_range<int>(0, stack.height), [&](const tbb::blocked_range<int>& rows) {
     std::vector<float> nb(static_cast<size_t>(neighborhood_dims(n, stack.channels)));

@@ -4,6 +4,16 @@
 
 namespace solidtex {
 
+CoordinateTriple shift_triple(const CoordinateTriple& t, const int d[3], const std::array<const ImageF*, kNumPlanes>& planes) {
+  CoordinateTriple out;
+  for (int k = 0; k < kNumPlanes; ++k) {
+    const ImageF& img = *planes[size_t(k)];
+    out.at[size_t(k)] = {ImageF::wrap(t.at[size_t(k)].x + d[kPlaneFirstAxis[size_t(k)]], img.width),
+                         ImageF::wrap(t.at[size_t(k)].y + d[kPlaneSecondAxis[size_t(k)]], img.height)};
+  }
+  return out;
+}
+
 ImageF transposed(const ImageF& in) {
   ImageF out(in.height, in.width, in.channels);
   for (int y = 0; y < in.height; ++y)

@@ -2,9 +2,12 @@
 // Pixels are interleaved, row-major, `channels` floats each. Color images hold *linear* RGB.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
+
+#include "core/types.h"
 
 namespace solidtex {
 
@@ -29,6 +32,10 @@ struct ImageF {
   }
   friend bool operator==(const ImageF&, const ImageF&) = default;
 };
+
+// Eq. 4 (Zhang §2): moving by a 3D step d moves plane k's pixel by (d[first_k], d[second_k]),
+// wrapped on plane k's image (`planes[k]`, toroidal).
+CoordinateTriple shift_triple(const CoordinateTriple& t, const int d[3], const std::array<const ImageF*, kNumPlanes>& planes);
 
 // Swaps the axes: out(x, y) = in(y, x).
 ImageF transposed(const ImageF& in);

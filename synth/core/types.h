@@ -17,6 +17,9 @@ inline constexpr int index_of(Plane p) { return static_cast<int>(p); }
 inline constexpr const char* plane_name(Plane p) {
   return p == Plane::kXY ? "xy" : p == Plane::kYZ ? "yz" : "zx";
 }
+// The 3D axes (0 = x, 1 = y, 2 = z) that plane k's exemplar x and y run along.
+inline constexpr std::array<int, kNumPlanes> kPlaneFirstAxis = {0, 1, 2};
+inline constexpr std::array<int, kNumPlanes> kPlaneSecondAxis = {1, 2, 0};
 
 // Integer pixel position in an exemplar image (toroidal: any integer is valid and wraps).
 struct ExemplarPixel {
@@ -32,6 +35,9 @@ struct CoordinateTriple {
   const ExemplarPixel& operator[](Plane p) const { return at[index_of(p)]; }
   friend constexpr auto operator<=>(const CoordinateTriple&, const CoordinateTriple&) = default;
 };
+
+// Floor division for any sign of a (b > 0): -1 / 2 is -1, not 0.
+inline constexpr int floor_div(int a, int b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
 
 // Pyramid level in synthesis order: 0 is the coarsest, levels-1 the finest.
 struct PyramidLevel {

@@ -7,13 +7,10 @@
 
 namespace solidtex {
 namespace {
-constexpr int kFirstAxis[3] = {0, 1, 2};
-constexpr int kSecondAxis[3] = {1, 2, 0};
-
 void local_offset(int plane, int i, int j, float out[3]) {
   out[0] = out[1] = out[2] = 0.f;
-  out[kFirstAxis[plane]] = float(i);
-  out[kSecondAxis[plane]] = float(j);
+  out[kPlaneFirstAxis[size_t(plane)]] = float(i);
+  out[kPlaneSecondAxis[size_t(plane)]] = float(j);
 }
 }  // namespace
 
@@ -104,14 +101,7 @@ CorrectionContext CorrectionContext::make(const Table& table, PyramidLevel l, co
   ctx.spacing = table.spacing(l);
   ctx.channels = table.exemplars().channels();
   ctx.dims = ctx.level->planes[0]->pca.output_dims;
-  for (int k = 0; k < 3; ++k) {
-    const PcaBasis& p = ctx.level->planes[size_t(k)]->pca;
-    ctx.basis_t[size_t(k)].resize(size_t(p.input_dims) * p.output_dims);
-    for (int r = 0; r < p.output_dims; ++r)
-      for (int i = 0; i < p.input_dims; ++i)
-        ctx.basis_t[size_t(k)][size_t(i) * p.output_dims + r] = p.basis[size_t(r) * p.input_dims + i];
-    ctx.mean[size_t(k)] = p.mean.data();
-  }
+  for (int k = 0; k < 3; ++k) ctx.projection[size_t(k)] = PcaProjection::of(ctx.level->planes[size_t(k)]->pca);
   return ctx;
 }
 
@@ -133,23 +123,12 @@ __attribute__((target_clones("avx2", "default"))) float plane_distance(const flo
   return (acc[0] + acc[1]) + (acc[2] + acc[3]);
 }
 
-// Lane-wise identical whatever the vector width (no FMA, no reassociation), so the AVX2 and
-// baseline clones give the same bits.
-__attribute__((target_clones("avx2", "default"))) void project_planes(const CorrectionContext& ctx, CorrectionScratch& s) {
+void project_planes(const CorrectionContext& ctx, CorrectionScratch& s) {
   const int in_dims = ctx.n * ctx.n * ctx.channels;
   const int d = ctx.dims;
-  s.projected.assign(size_t(3) * d, 0.f);
-  for (int k = 0; k < 3; ++k) {
-    const float* g = s.gathered.data() + size_t(k) * in_dims;
-    const float* mean = ctx.mean[size_t(k)];
-    const float* bt = ctx.basis_t[size_t(k)].data();
-    float* out = s.projected.data() + size_t(k) * d;
-    for (int i = 0; i < in_dims; ++i) {
-      const float centred = g[i] - mean[i];
-      const float* row = bt + size_t(i) * d;
-      for (int r = 0; r < d; ++r) out[r] += row[r] * centred;  // independent accumulators: vectorises
-    }
-  }
+  s.projected.resize(size_t(3) * d);
+  for (int k = 0; k < 3; ++k)
+    ctx.projection[size_t(k)].project(s.gathered.data() + size_t(k) * in_dims, s.projected.data() + size_t(k) * d);
 }
 
 CoordinateTriple best_candidate(const CorrectionContext& ctx, const CoordinateTriple& current,

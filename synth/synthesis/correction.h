@@ -70,8 +70,7 @@ struct CorrectionContext {
   int spacing = 1;
   int channels = 3;
   int dims = 0;                                      // PCA output dims per plane
-  std::array<std::vector<float>, 3> basis_t;         // input-major PCA bases
-  std::array<const float*, 3> mean{};
+  std::array<PcaProjection, 3> projection;           // per plane
   PlaneWeights cost_weights{1.f, 1.f, 1.f};          // per-plane matching weights
   int candidates_per_source = 64;                    // table candidates tried per source pixel
   PlaneWeights color_weights{1.f / 3, 1.f / 3, 1.f / 3};

@@ -3,27 +3,18 @@
 #include <cmath>
 
 #include "core/hash.h"
-#include "synthesis/voxel_mask.h"
 
 namespace solidtex {
 namespace {
-constexpr int kFirstAxis[3] = {0, 1, 2};
-constexpr int kSecondAxis[3] = {1, 2, 0};
+std::array<const ImageF*, kNumPlanes> exemplar_planes(const Table& table) {
+  const ExemplarSet& e = table.exemplars();
+  return {&e.plane(Plane::kXY), &e.plane(Plane::kYZ), &e.plane(Plane::kZX)};
+}
 }  // namespace
 
 WorldPoint voxel_centre(PyramidLevel level, int levels, const Voxel& v) {
   const double s = double(stack_spacing(level, levels));
   return {(v.x + 0.5) * s - 0.5, (v.y + 0.5) * s - 0.5, (v.z + 0.5) * s - 0.5};
-}
-
-CoordinateTriple shift_triple(const Table& table, const CoordinateTriple& t, const int step[3]) {
-  CoordinateTriple out = t;
-  for (int k = 0; k < 3; ++k) {
-    const ImageF& img = table.exemplars().plane(plane_from_index(k));
-    out.at[size_t(k)].x = ImageF::wrap(t.at[size_t(k)].x + step[kFirstAxis[k]], img.width);
-    out.at[size_t(k)].y = ImageF::wrap(t.at[size_t(k)].y + step[kSecondAxis[k]], img.height);
-  }
-  return out;
 }
 
 CoordinateTriple init_triple(const Table& table, const Voxel& v, const Rot3& r, const SynthesisParams& params) {
@@ -53,7 +44,7 @@ CoordinateTriple init_triple(const Table& table, const Voxel& v, const Rot3& r, 
     base = list[0];
   }
   const int step[3] = {0, 0, h * dz};
-  return shift_triple(table, base, step);
+  return shift_triple(base, step, exemplar_planes(table));
 }
 
 CoordinateTriple upsample_triple(const Table& table, PyramidLevel child_level, const Voxel& v,
@@ -63,7 +54,7 @@ CoordinateTriple upsample_triple(const Table& table, PyramidLevel child_level, c
   float local[3];
   parent_rotation.apply_inverse(t, local);
   const int step[3] = {int(std::lround(local[0])), int(std::lround(local[1])), int(std::lround(local[2]))};
-  return shift_triple(table, parent, step);
+  return shift_triple(parent, step, exemplar_planes(table));
 }
 
 }  // namespace solidtex

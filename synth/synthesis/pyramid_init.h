@@ -25,7 +25,5 @@ CoordinateTriple upsample_triple(const Table& table, PyramidLevel child_level, c
                                  const CoordinateTriple& parent, const Rot3& parent_rotation);
 // World-space centre of voxel v at `level` (one world unit = one finest voxel).
 WorldPoint voxel_centre(PyramidLevel level, int levels, const Voxel& v);
-// Moves a triple by a 3D exemplar-pixel step (Eq. 4) and wraps into the exemplars.
-CoordinateTriple shift_triple(const Table& table, const CoordinateTriple& t, const int step[3]);
 
 }  // namespace solidtex

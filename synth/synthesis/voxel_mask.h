@@ -29,8 +29,6 @@ struct VoxelBox {
   int64_t volume() const { return empty() ? 0 : int64_t(hi.x - lo.x) * (hi.y - lo.y) * (hi.z - lo.z); }
 };
 
-inline int floor_div(int a, int b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
-
 class VoxelMask {
  public:
   VoxelMask() = default;
