@@ -2,16 +2,12 @@
 
 namespace solidtex {
 
-LevelStore::LevelStore(const VoxelBox& box, int slots) : box_(box), slots_(slots) {
-  if (box.empty()) return;
-  b0_ = {floor_div(box.lo.x, 8), floor_div(box.lo.y, 8), floor_div(box.lo.z, 8)};
-  bn_ = {floor_div(box.hi.x - 1, 8) - b0_[0] + 1, floor_div(box.hi.y - 1, 8) - b0_[1] + 1,
-         floor_div(box.hi.z - 1, 8) - b0_[2] + 1};
-  table_.assign(size_t(bn_[0]) * bn_[1] * bn_[2], nullptr);
+LevelStore::LevelStore(const VoxelBox& box, int slots) : box_(box), slots_(slots), index_(box) {
+  table_.assign(index_.size(), nullptr);
 }
 
 void LevelStore::allocate(const Voxel& p) {
-  Brick*& b = table_[size_t(brick_index(p))];
+  Brick*& b = table_[index_.brick_of(p)];
   if (b) return;
   auto nb = std::make_unique<Brick>();
   nb->states.resize(size_t(512) * slots_);

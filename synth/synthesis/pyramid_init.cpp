@@ -12,11 +12,6 @@ std::array<const ImageF*, kNumPlanes> exemplar_planes(const Table& table) {
 }
 }  // namespace
 
-WorldPoint voxel_centre(PyramidLevel level, int levels, const Voxel& v) {
-  const double s = double(stack_spacing(level, levels));
-  return {(v.x + 0.5) * s - 0.5, (v.y + 0.5) * s - 0.5, (v.z + 0.5) * s - 0.5};
-}
-
 CoordinateTriple init_triple(const Table& table, const Voxel& v, const Rot3& r, const SynthesisParams& params) {
   const PyramidLevel coarsest{0};
   const int h = table.spacing(coarsest);

@@ -23,7 +23,5 @@ namespace solidtex {
 CoordinateTriple init_triple(const Table& table, const Voxel& v, const Rot3& r, const SynthesisParams& params);
 CoordinateTriple upsample_triple(const Table& table, PyramidLevel child_level, const Voxel& v,
                                  const CoordinateTriple& parent, const Rot3& parent_rotation);
-// World-space centre of voxel v at `level` (one world unit = one finest voxel).
-WorldPoint voxel_centre(PyramidLevel level, int levels, const Voxel& v);
 
 }  // namespace solidtex

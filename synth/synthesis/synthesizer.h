@@ -1,16 +1,17 @@
 // Lazy, spatially deterministic solid synthesis (Zhang §4-5) over an unbounded voxel lattice.
 //
-// synthesize() computes only what the target voxels depend on:
-//  1. backwards, finest level first: the target (or the parents the finer level needs) at the
-//     final version, minus what the cache holds; then, step by step down to version 0, every
-//     (voxel, version) a correction reads, as named by the step's history window and the
-//     voxel's read stencil (correction.h). Version-0 voxels need their parents one level up.
-//  2. forwards, coarsest level first: initialise or upsample version 0, then run each step on
-//     exactly the voxels it updates within the sets, in parallel (TBB).
+// synthesize() computes only what the target voxels depend on, in named stages:
+//  1. dependency analysis (dependency.h), backwards from the finest level: per level and
+//     version, the voxels the target depends on, minus what the cache holds;
+//  2. per level, coarsest first: a request-local LevelStore of the level's sets; version 0 by
+//     initialisation or upsampling (pyramid_init.h); each correction step on exactly the voxels
+//     of its set that it updates, in parallel (TBB; correction.h);
+//  3. cache write-back of the level's final versions;
+//  4. output colors of the finest level's final versions.
+// Instrumented mode (SynthesisOptions::instrument) checks the sets' soundness and tightness.
 // Purity: the value of (level, voxel, version) depends only on the table, field, parameters
 // and seed: never on the request, order, thread count or cache state (tests check bits).
-// Fields: the finest level uses the field at each voxel centre; coarser levels a smoothed
-// field (mean of 8 samples over the voxel's footprint), as in Zhang §6.
+// Fields: frames and stencils per voxel and level come from frame_stencils.h (Zhang §6).
 // Thread-safety: synthesize() may run concurrently; requests share only the VoxelCache.
 #pragma once
 

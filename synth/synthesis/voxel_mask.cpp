@@ -1,25 +1,10 @@
 #include "synthesis/voxel_mask.h"
 
-#include <algorithm>
-
 namespace solidtex {
 
-void VoxelBox::include(const Voxel& p) {
-  if (empty()) {
-    lo = p;
-    hi = {p.x + 1, p.y + 1, p.z + 1};
-    return;
-  }
-  lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
-  hi = {std::max(hi.x, p.x + 1), std::max(hi.y, p.y + 1), std::max(hi.z, p.z + 1)};
-}
-
-VoxelMask::VoxelMask(const VoxelBox& box) : box_(box) {
+VoxelMask::VoxelMask(const VoxelBox& box) : box_(box), index_(box) {
   if (box.empty()) return;
-  b0_ = {floor_div(box.lo.x, 8), floor_div(box.lo.y, 8), floor_div(box.lo.z, 8)};
-  bn_ = {floor_div(box.hi.x - 1, 8) - b0_[0] + 1, floor_div(box.hi.y - 1, 8) - b0_[1] + 1,
-         floor_div(box.hi.z - 1, 8) - b0_[2] + 1};
-  table_size_ = size_t(bn_[0]) * bn_[1] * bn_[2];
+  table_size_ = index_.size();
   table_ = std::make_unique<std::atomic<int32_t>[]>(table_size_);
   for (size_t i = 0; i < table_size_; ++i) table_[i].store(-1, std::memory_order_relaxed);
   // Readers index pool_ without the lock: it must never reallocate.
@@ -27,13 +12,12 @@ VoxelMask::VoxelMask(const VoxelBox& box) : box_(box) {
 }
 
 VoxelMask::VoxelMask(VoxelMask&& o) noexcept
-    : box_(o.box_), b0_(o.b0_), bn_(o.bn_), table_(std::move(o.table_)), table_size_(o.table_size_),
+    : box_(o.box_), index_(o.index_), table_(std::move(o.table_)), table_size_(o.table_size_),
       pool_(std::move(o.pool_)), bricks_(o.bricks_), count_(o.count_.load()) {}
 
 VoxelMask& VoxelMask::operator=(VoxelMask&& o) noexcept {
   box_ = o.box_;
-  b0_ = o.b0_;
-  bn_ = o.bn_;
+  index_ = o.index_;
   table_ = std::move(o.table_);
   table_size_ = o.table_size_;
   pool_ = std::move(o.pool_);
@@ -42,7 +26,7 @@ VoxelMask& VoxelMask::operator=(VoxelMask&& o) noexcept {
   return *this;
 }
 
-int32_t VoxelMask::allocate_brick(int b) {
+int32_t VoxelMask::allocate_brick(size_t b) {
   std::lock_guard<std::mutex> g(alloc_);
   int32_t idx = table_[size_t(b)].load(std::memory_order_acquire);
   if (idx >= 0) return idx;
@@ -58,10 +42,10 @@ int32_t VoxelMask::allocate_brick(int b) {
 }
 
 bool VoxelMask::insert(const Voxel& p) {
-  const int b = brick_index(p);
-  int32_t idx = table_[size_t(b)].load(std::memory_order_acquire);
+  const size_t b = index_.brick_of(p);
+  int32_t idx = table_[b].load(std::memory_order_acquire);
   if (idx < 0) idx = allocate_brick(b);
-  const int bit = (p.x & 7) + 8 * (p.y & 7) + 64 * (p.z & 7);
+  const int bit = BrickIndex::voxel_in_brick(p);
   std::atomic<uint64_t>& word = (*brick_at(idx))[size_t(bit >> 6)];
   const uint64_t m = uint64_t(1) << (bit & 63);
   if (word.load(std::memory_order_relaxed) & m) return false;
@@ -72,31 +56,29 @@ bool VoxelMask::insert(const Voxel& p) {
 
 bool VoxelMask::contains(const Voxel& p) const {
   if (!box_.contains(p)) return false;
-  const int32_t idx = table_[size_t(brick_index(p))].load(std::memory_order_acquire);
+  const int32_t idx = table_[index_.brick_of(p)].load(std::memory_order_acquire);
   if (idx < 0) return false;
-  const int bit = (p.x & 7) + 8 * (p.y & 7) + 64 * (p.z & 7);
+  const int bit = BrickIndex::voxel_in_brick(p);
   return ((*brick_at(idx))[size_t(bit >> 6)].load(std::memory_order_relaxed) >> (bit & 63)) & 1;
 }
 
 std::vector<Voxel> VoxelMask::to_vector() const {
   std::vector<Voxel> out;
   out.reserve(size_t(count()));
-  for (int bz = 0; bz < bn_[2]; ++bz)
-    for (int by = 0; by < bn_[1]; ++by)
-      for (int bx = 0; bx < bn_[0]; ++bx) {
-        const int32_t idx = table_[(size_t(bz) * bn_[1] + by) * bn_[0] + bx].load(std::memory_order_acquire);
-        if (idx < 0) continue;
-        const Brick& bits = *brick_at(idx);
-        for (int w = 0; w < 8; ++w) {
-          uint64_t word = bits[size_t(w)].load(std::memory_order_relaxed);
-          while (word) {
-            const int bit = w * 64 + __builtin_ctzll(word);
-            word &= word - 1;
-            out.push_back({(b0_[0] + bx) * 8 + (bit & 7), (b0_[1] + by) * 8 + ((bit >> 3) & 7),
-                           (b0_[2] + bz) * 8 + (bit >> 6)});
-          }
-        }
+  for (size_t b = 0; b < table_size_; ++b) {
+    const int32_t idx = table_[b].load(std::memory_order_acquire);
+    if (idx < 0) continue;
+    const Voxel origin = index_.brick_origin(b);
+    const Brick& bits = *brick_at(idx);
+    for (int w = 0; w < 8; ++w) {
+      uint64_t word = bits[size_t(w)].load(std::memory_order_relaxed);
+      while (word) {
+        const int bit = w * 64 + __builtin_ctzll(word);
+        word &= word - 1;
+        out.push_back(BrickIndex::voxel_at(origin, bit));
       }
+    }
+  }
   return out;
 }
 

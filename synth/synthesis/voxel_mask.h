@@ -1,5 +1,5 @@
 // Sparse voxel sets for dependency analysis: 8^3-voxel bit bricks, allocated on first use,
-// indexed by a dense brick table over a fixed bounding box. Insert/contains are O(1) with no
+// indexed by a dense brick table over a fixed bounding box (brick_index.h). Insert/contains are O(1) with no
 // hashing; iteration is in a fixed (brick, then bit) order whatever the insertion order, so
 // anything derived from a mask is deterministic. insert() is thread-safe (atomic bit-or, brick
 // allocation under a lock); contains()/to_vector() must not race with inserts.
@@ -12,22 +12,9 @@
 #include <mutex>
 #include <vector>
 
-#include "core/types.h"
+#include "synthesis/brick_index.h"
 
 namespace solidtex {
-
-// Half-open voxel box [lo, hi).
-struct VoxelBox {
-  Voxel lo{0, 0, 0};
-  Voxel hi{0, 0, 0};
-  bool empty() const { return hi.x <= lo.x || hi.y <= lo.y || hi.z <= lo.z; }
-  bool contains(const Voxel& p) const {
-    return p.x >= lo.x && p.y >= lo.y && p.z >= lo.z && p.x < hi.x && p.y < hi.y && p.z < hi.z;
-  }
-  VoxelBox dilated(int r) const { return {{lo.x - r, lo.y - r, lo.z - r}, {hi.x + r, hi.y + r, hi.z + r}}; }
-  void include(const Voxel& p);
-  int64_t volume() const { return empty() ? 0 : int64_t(hi.x - lo.x) * (hi.y - lo.y) * (hi.z - lo.z); }
-};
 
 class VoxelMask {
  public:
@@ -44,16 +31,13 @@ class VoxelMask {
   std::vector<Voxel> to_vector() const;
 
  private:
-  int brick_index(const Voxel& p) const {
-    return (((p.z >> 3) - b0_[2]) * bn_[1] + ((p.y >> 3) - b0_[1])) * bn_[0] + ((p.x >> 3) - b0_[0]);  // >> floors (C++20)
-  }
   using Brick = std::array<std::atomic<uint64_t>, 8>;  // 512 bits: bit (x + 8y + 64z)
   static constexpr int kChunk = 1024;                  // bricks per pool chunk (stable addresses)
   Brick* brick_at(int32_t index) const { return &(*pool_[size_t(index / kChunk)])[size_t(index % kChunk)]; }
-  int32_t allocate_brick(int b);
+  int32_t allocate_brick(size_t b);
 
   VoxelBox box_;
-  std::array<int, 3> b0_{}, bn_{};
+  BrickIndex index_;
   std::unique_ptr<std::atomic<int32_t>[]> table_;  // brick -> pool index, or -1
   size_t table_size_ = 0;
   std::vector<std::unique_ptr<std::array<Brick, kChunk>>> pool_;
