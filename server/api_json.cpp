@@ -1,84 +1,141 @@
 #include "api_json.h"
 
+#include <array>
+#include <cstdint>
+#include <set>
+#include <string>
+#include <variant>
+
 #include "core/json_fields.h"
 
 namespace solidtex::server {
 
 using nlohmann::json;
 
-json to_json(const AnalysisParams& p) {
-  return {{"levels", p.levels},         {"neighborhood", p.neighborhood}, {"candidates", p.candidates},
-          {"pca_dims", p.pca_dims},     {"search_k", p.search_k},         {"knn_checks", p.knn_checks},
-          {"seed", p.seed},             {"suggested_plane_weights", p.suggested_plane_weights}};
+namespace {
+
+// One JSON key of a parameter struct P: the member it stands for and, for numbers, the range
+// the JSON value must lie in (each element's, for the weight triples). The struct's own
+// validate() runs afterwards for the rules that involve several members.
+template <typename P>
+struct Param {
+  using Member = std::variant<int P::*, uint32_t P::*, std::array<float, 3> P::*, Scheme P::*, Matcher P::*>;
+  const char* key;
+  Member member;
+  int64_t lo = 0, hi = 0;
+};
+
+// Both directions of every key, in the order errors are looked for.
+constexpr Param<AnalysisParams> kAnalysisParams[] = {
+    {"levels", &AnalysisParams::levels, 1, 8},
+    {"neighborhood", &AnalysisParams::neighborhood, 3, 15},
+    {"candidates", &AnalysisParams::candidates, 1, 32},
+    {"pca_dims", &AnalysisParams::pca_dims, 1, 64},
+    {"search_k", &AnalysisParams::search_k, 1, 64},
+    {"knn_checks", &AnalysisParams::knn_checks, 16, 100000},
+    {"seed", &AnalysisParams::seed, 0, 1 << 30},
+    {"suggested_plane_weights", &AnalysisParams::suggested_plane_weights, 0, 1},
+};
+
+// SynthesisParams::seed is not a key: volumes take it from their own "seed".
+constexpr Param<SynthesisParams> kSynthesisParams[] = {
+    {"scheme", &SynthesisParams::scheme},
+    {"matcher", &SynthesisParams::matcher},
+    {"coarse_passes", &SynthesisParams::coarse_passes, 0, 8},
+    {"passes", &SynthesisParams::passes, 0, 8},
+    {"subpass_size", &SynthesisParams::subpass_size, 1, 2},
+    {"cell_size", &SynthesisParams::cell_size, 4, 64},
+    {"init_subpart", &SynthesisParams::init_subpart, 8, 256},
+    {"trilinear_levels", &SynthesisParams::trilinear_levels, 0, 8},
+    {"plane_weights", &SynthesisParams::plane_weights, 0, 1},
+};
+
+template <typename... F>
+struct Overloaded : F... {
+  using F::operator()...;
+};
+
+// A named enum value; the parser's message (e.g. "scheme 'standard' was renamed 'plain' ...")
+// is kept, the field becomes the value's path.
+template <typename E>
+Status read_name(const json& v, const std::string& field, Result<E> (*parse)(const std::string&), E& out) {
+  SOLIDTEX_ASSIGN_OR_RETURN(std::string s, json_string(v, field));
+  Result<E> r = parse(s);
+  if (!r) return Status(StatusCode::kInvalidArgument, r.status().message(), field);
+  out = *r;
+  return Status::ok();
 }
+
+template <typename P>
+Status read_param(const Param<P>& d, const json& v, const std::string& field, P& p) {
+  return std::visit(
+      Overloaded{
+          [&](int P::*m) -> Status {
+            SOLIDTEX_ASSIGN_OR_RETURN(int64_t x, json_int(v, field, d.lo, d.hi));
+            p.*m = int(x);
+            return Status::ok();
+          },
+          [&](uint32_t P::*m) -> Status {
+            SOLIDTEX_ASSIGN_OR_RETURN(int64_t x, json_int(v, field, d.lo, d.hi));
+            p.*m = uint32_t(x);
+            return Status::ok();
+          },
+          [&](std::array<float, 3> P::*m) -> Status {
+            if (!v.is_array() || v.size() != 3) return Status(StatusCode::kInvalidArgument, "must be 3 numbers", field);
+            for (size_t i = 0; i < 3; ++i) {
+              SOLIDTEX_ASSIGN_OR_RETURN(double x, json_number(v[i], field, double(d.lo), double(d.hi)));
+              (p.*m)[i] = float(x);
+            }
+            return Status::ok();
+          },
+          [&](Scheme P::*m) { return read_name(v, field, &parse_scheme, p.*m); },
+          [&](Matcher P::*m) { return read_name(v, field, &parse_matcher, p.*m); },
+      },
+      d.member);
+}
+
+template <typename P, size_t N>
+json write_params(const P& p, const Param<P> (&table)[N]) {
+  json out = json::object();
+  for (const Param<P>& d : table)
+    out[d.key] = std::visit(Overloaded{
+                                [&](Scheme P::*m) { return json(scheme_name(p.*m)); },
+                                [&](Matcher P::*m) { return json(matcher_name(p.*m)); },
+                                [&](auto m) { return json(p.*m); },
+                            },
+                            d.member);
+  return out;
+}
+
+// Strict decoding into `p` (which supplies what `j` leaves out): unknown keys, then each key
+// in table order, then p.validate(); every error names its field as `where`.key.
+template <typename P, size_t N>
+Result<P> read_params(const json& j, const std::string& where, const Param<P> (&table)[N], P p) {
+  auto path = [&](const std::string& key) { return where.empty() ? key : where + "." + key; };
+  std::set<std::string> keys;
+  for (const Param<P>& d : table) keys.insert(d.key);
+  SOLIDTEX_RETURN_IF_ERROR(check_keys(j, keys, where));
+  for (const Param<P>& d : table) {
+    const auto it = j.find(d.key);
+    if (it != j.end()) SOLIDTEX_RETURN_IF_ERROR(read_param(d, *it, path(d.key), p));
+  }
+  const Status st = p.validate();
+  if (!st.is_ok()) return Status(st.code(), st.message(), st.field().empty() ? where : path(st.field()));
+  return p;
+}
+
+}  // namespace
+
+json to_json(const AnalysisParams& p) { return write_params(p, kAnalysisParams); }
 
 Result<AnalysisParams> analysis_params_from_json(const json& j, const std::string& where) {
-  SOLIDTEX_RETURN_IF_ERROR(check_keys(j, {"levels", "neighborhood", "candidates", "pca_dims", "search_k", "knn_checks",
-                                          "seed", "suggested_plane_weights"},
-                                      where));
-  AnalysisParams p;
-  auto field = [&](const char* k) { return where + "." + k; };
-  if (j.contains("levels")) { SOLIDTEX_ASSIGN_OR_RETURN(p.levels, json_int(j["levels"], field("levels"), 1, 8)); }
-  if (j.contains("neighborhood")) { SOLIDTEX_ASSIGN_OR_RETURN(p.neighborhood, json_int(j["neighborhood"], field("neighborhood"), 3, 15)); }
-  if (j.contains("candidates")) { SOLIDTEX_ASSIGN_OR_RETURN(p.candidates, json_int(j["candidates"], field("candidates"), 1, 32)); }
-  if (j.contains("pca_dims")) { SOLIDTEX_ASSIGN_OR_RETURN(p.pca_dims, json_int(j["pca_dims"], field("pca_dims"), 1, 64)); }
-  if (j.contains("search_k")) { SOLIDTEX_ASSIGN_OR_RETURN(p.search_k, json_int(j["search_k"], field("search_k"), 1, 64)); }
-  if (j.contains("knn_checks")) { SOLIDTEX_ASSIGN_OR_RETURN(p.knn_checks, json_int(j["knn_checks"], field("knn_checks"), 16, 100000)); }
-  if (j.contains("seed")) { SOLIDTEX_ASSIGN_OR_RETURN(auto s, json_int(j["seed"], field("seed"), 0, 1 << 30)); p.seed = uint32_t(s); }
-  if (j.contains("suggested_plane_weights")) {
-    const json& w = j["suggested_plane_weights"];
-    if (!w.is_array() || w.size() != 3) return Status(StatusCode::kInvalidArgument, "must be 3 numbers", field("suggested_plane_weights"));
-    for (size_t i = 0; i < 3; ++i) {
-      SOLIDTEX_ASSIGN_OR_RETURN(double v, json_number(w[i], field("suggested_plane_weights"), 0, 1));
-      p.suggested_plane_weights[i] = float(v);
-    }
-  }
-  SOLIDTEX_RETURN_IF_ERROR(p.validate());
-  return p;
+  return read_params(j, where, kAnalysisParams, AnalysisParams{});
 }
 
-json to_json(const SynthesisParams& p) {
-  return {{"scheme", scheme_name(p.scheme)},   {"matcher", matcher_name(p.matcher)},
-          {"coarse_passes", p.coarse_passes},  {"passes", p.passes},
-          {"subpass_size", p.subpass_size},    {"cell_size", p.cell_size},
-          {"init_subpart", p.init_subpart},    {"trilinear_levels", p.trilinear_levels},
-          {"plane_weights", p.plane_weights}};
-}
+json to_json(const SynthesisParams& p) { return write_params(p, kSynthesisParams); }
 
-Result<SynthesisParams> synthesis_params_from_json(const json& j, const std::string& where, SynthesisParams p) {
-  SOLIDTEX_RETURN_IF_ERROR(check_keys(j, {"scheme", "matcher", "coarse_passes", "passes", "subpass_size", "cell_size",
-                                          "init_subpart", "trilinear_levels", "plane_weights"},
-                                      where));
-  auto field = [&](const char* k) { return where + "." + k; };
-  if (j.contains("scheme")) {
-    SOLIDTEX_ASSIGN_OR_RETURN(std::string s, json_string(j["scheme"], field("scheme")));
-    auto r = parse_scheme(s);
-    if (!r) return Status(StatusCode::kInvalidArgument, r.status().message(), field("scheme"));
-    p.scheme = *r;
-  }
-  if (j.contains("matcher")) {
-    SOLIDTEX_ASSIGN_OR_RETURN(std::string s, json_string(j["matcher"], field("matcher")));
-    auto r = parse_matcher(s);
-    if (!r) return Status(StatusCode::kInvalidArgument, r.status().message(), field("matcher"));
-    p.matcher = *r;
-  }
-  if (j.contains("coarse_passes")) { SOLIDTEX_ASSIGN_OR_RETURN(p.coarse_passes, json_int(j["coarse_passes"], field("coarse_passes"), 0, 8)); }
-  if (j.contains("passes")) { SOLIDTEX_ASSIGN_OR_RETURN(p.passes, json_int(j["passes"], field("passes"), 0, 8)); }
-  if (j.contains("subpass_size")) { SOLIDTEX_ASSIGN_OR_RETURN(p.subpass_size, json_int(j["subpass_size"], field("subpass_size"), 1, 2)); }
-  if (j.contains("cell_size")) { SOLIDTEX_ASSIGN_OR_RETURN(p.cell_size, json_int(j["cell_size"], field("cell_size"), 4, 64)); }
-  if (j.contains("init_subpart")) { SOLIDTEX_ASSIGN_OR_RETURN(p.init_subpart, json_int(j["init_subpart"], field("init_subpart"), 8, 256)); }
-  if (j.contains("trilinear_levels")) { SOLIDTEX_ASSIGN_OR_RETURN(p.trilinear_levels, json_int(j["trilinear_levels"], field("trilinear_levels"), 0, 8)); }
-  if (j.contains("plane_weights")) {
-    const json& w = j["plane_weights"];
-    if (!w.is_array() || w.size() != 3) return Status(StatusCode::kInvalidArgument, "must be 3 numbers", field("plane_weights"));
-    for (size_t i = 0; i < 3; ++i) {
-      SOLIDTEX_ASSIGN_OR_RETURN(double v, json_number(w[i], field("plane_weights"), 0, 1));
-      p.plane_weights[i] = float(v);
-    }
-  }
-  Status st = p.validate();
-  if (!st.is_ok()) return Status(st.code(), st.message(), st.field().empty() ? where : where + "." + st.field());
-  return p;
+Result<SynthesisParams> synthesis_params_from_json(const json& j, const std::string& where, SynthesisParams base) {
+  return read_params(j, where, kSynthesisParams, std::move(base));
 }
 
 json to_json(const std::vector<LevelReport>& levels) {

@@ -1,6 +1,8 @@
 // JSON encodings of the service's parameter structs, shared by the services and handlers.
-// Decoding is strict: unknown keys are errors naming their path; values are range-checked by
-// the structs' own validate().
+// Each params struct has one table of (JSON key, member, range) in api_json.cpp driving both
+// directions. Decoding is strict: unknown keys are errors naming their path, each value is
+// type- and range-checked, then the struct's own validate() runs; every error's field is the
+// path of the offending key (`where`.key, e.g. "params.passes").
 #pragma once
 
 #include <nlohmann/json.hpp>

@@ -19,8 +19,15 @@ namespace {
 constexpr size_t kMaxLiveSolvers = 8;
 constexpr int64_t kMaxFramesPerRequest = 65536;
 
-std::string stf_name(int revision) { return "r" + std::to_string(revision) + ".stf"; }
-std::string json_name(int revision) { return "r" + std::to_string(revision) + ".json"; }
+// r<N>.stf, r<N>.json (built by appending: GCC 12 warns falsely (-Wrestrict) about "r" + std::string).
+std::string revision_name(int revision, const char* extension) {
+  std::string s = "r";
+  s += std::to_string(revision);
+  s += extension;
+  return s;
+}
+std::string stf_name(int revision) { return revision_name(revision, ".stf"); }
+std::string json_name(int revision) { return revision_name(revision, ".json"); }
 
 struct FieldEntry {
   int revision = 0;
@@ -43,26 +50,9 @@ struct FieldService::Impl {
 
   Impl(DataStore& s, const ServerConfig& c) : store(s), config(c) {}
 
-  // Solves the curves of `sketch` one by one, checking the interrupter in between.
-  Result<std::unique_ptr<FieldSolver>> solve(const Sketch& sketch, Interrupter& interrupter, FieldSolveStats& stats) {
-    SOLIDTEX_ASSIGN_OR_RETURN(auto solver, FieldSolver::create(sketch.domain));
-    const auto d = solver->dims();
-    const int64_t nodes = int64_t(d[0]) * d[1] * d[2];
-    if (nodes > config.max_field_nodes)
-      return Status(StatusCode::kUnprocessable,
-                    "the field grid would have " + std::to_string(nodes) + " nodes; the limit is " +
-                        std::to_string(config.max_field_nodes) + " (lower shortest_side_cells or the domain's aspect)",
-                    "domain.shortest_side_cells");
-    const auto t0 = std::chrono::steady_clock::now();
-    SOLIDTEX_RETURN_IF_ERROR(solver->add_frames(sketch.frames, &stats));
-    for (size_t i = 0; i < sketch.curves.size(); ++i) {
-      if (interrupter.was_interrupted(int(100 * i / sketch.curves.size())))
-        return Status(StatusCode::kCancelled, "field solve interrupted");
-      SOLIDTEX_RETURN_IF_ERROR(solver->add_curve(sketch.curves[i], int(i), &stats));
-    }
-    SOLIDTEX_RETURN_IF_ERROR(solver->set_scales(sketch.scales));
-    stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    return solver;
+  // Solves a whole sketch within the configured grid-size limit (422 beyond it).
+  Result<std::unique_ptr<FieldSolver>> solve(const Sketch& sketch, Interrupter& interrupter, FieldSolveStats& stats) const {
+    return FieldSolver::solve(sketch, &stats, interrupter, config.max_field_nodes);
   }
 
   // Writes revision `revision` (the .stf, then its .json) and returns the info.
@@ -237,9 +227,8 @@ Result<json> FieldService::add_curve(const std::string& id, const std::string& c
   if (!solver) {
     SOLIDTEX_ASSIGN_OR_RETURN(solver, impl_->solve(sketch, interrupter, stats));
   }
-  if (interrupter.was_interrupted()) return Status(StatusCode::kCancelled, "field solve interrupted");
   const auto t0 = std::chrono::steady_clock::now();
-  SOLIDTEX_RETURN_IF_ERROR(solver->add_curve(curve, index, &stats));
+  SOLIDTEX_RETURN_IF_ERROR(solver->add_curve(curve, index, &stats, interrupter));
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   // The stored sketch grows by the curve, so the revision's file is a complete sketch.
   json sketch_json = json::parse(current.sketch_json);

@@ -3,7 +3,9 @@
 // A revision never changes once written, and volumes copy the revision they use, so adding a
 // curve never alters an existing volume. The solver of a recently used field stays in memory
 // so that adding a curve re-solves incrementally (warm start); after a restart the first added
-// curve re-solves the stored sketch first. Solves check the interrupter between curves.
+// curve re-solves the stored sketch first. Solves poll the interrupter throughout (FieldSolver:
+// at every conjugate-gradient iteration), and grids beyond config.max_field_nodes are
+// refused before anything is allocated.
 // Thread-safe; operations on one field are serialised.
 #pragma once
 

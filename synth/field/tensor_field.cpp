@@ -5,6 +5,8 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <string>
 
 namespace solidtex {
 namespace {
@@ -64,6 +66,56 @@ Quat shortest_arc(const Vec3& a, const Vec3& b) {
 
 Quat negate(const Quat& q) { return {-q.w, -q.x, -q.y, -q.z}; }
 
+Status cancelled() { return Status(StatusCode::kCancelled, "field solve cancelled"); }
+
+// One piece of an operation: the interrupter to poll and the piece's share [lo, hi] of the
+// operation's percent range (was_interrupted receives lo + (hi - lo) * fraction done).
+struct Progress {
+  Interrupter* interrupter = &null_interrupter();
+  double lo = 0, hi = 100;
+  bool interrupted(double fraction = 0) const { return interrupter->was_interrupted(int(lo + (hi - lo) * fraction)); }
+  Progress part(double a, double b) const { return {interrupter, lo + (hi - lo) * a, lo + (hi - lo) * b}; }
+};
+
+// Calls start()/end() around a public operation.
+class Task {
+ public:
+  Task(Interrupter& i, const char* name) : i_(i) { i_.start(name); }
+  ~Task() { i_.end(); }
+  Task(const Task&) = delete;
+  Task& operator=(const Task&) = delete;
+
+ private:
+  Interrupter& i_;
+};
+
+// Thrown by PolledCholesky to leave Eigen's CG loop; always caught in this file.
+struct Interrupted {};
+
+// The incomplete-Cholesky preconditioner, polling `progress` each time CG applies it (once per
+// iteration). Eigen's CG loop has no other hook, so stopping it takes an exception. The
+// preconditioner itself is the base class's, so solutions are bit-for-bit those of
+// Eigen::IncompleteCholesky.
+class PolledCholesky : public Eigen::IncompleteCholesky<double> {
+ public:
+  const Progress* progress = nullptr;
+  template <typename Rhs>
+  auto solve(const Eigen::MatrixBase<Rhs>& b) const {
+    if (progress && progress->interrupted()) throw Interrupted{};
+    return Eigen::IncompleteCholesky<double>::solve(b);
+  }
+};
+using Cg = Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper, PolledCholesky>;
+
+// "12345", "about 1.65e+13" or "more than 1e308": a node count that may not fit an integer.
+std::string node_count_text(const double count[3], double total) {
+  if (total < 9e18) return std::to_string(int64_t(count[0]) * int64_t(count[1]) * int64_t(count[2]));
+  if (!std::isfinite(total)) return "more than 1e308";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "about %.3g", total);
+  return buf;
+}
+
 }  // namespace
 
 Quat frame_from_tangent_normal(const WorldPoint& tangent, const WorldPoint& normal, int axis) {
@@ -98,19 +150,50 @@ struct FieldSolver::Impl {
   int curves = 0;
   std::vector<std::array<double, 3>> log_scales;
 
-  // CG solve of (L + C) x = b for several right-hand sides (columns), warm-started.
-  Eigen::MatrixXd cg_solve(const std::vector<Eigen::Triplet<double>>& cons, const Eigen::MatrixXd& b,
-                           const Eigen::MatrixXd& guess) const {
+  // The operations behind the public ones (which add start()/end() and undo on failure).
+  Status add_curve(const SketchCurve& c, int index, FieldSolveStats* stats, const Progress& progress);
+  Status add_frames(const std::vector<SketchFrame>& frames, FieldSolveStats* stats, const Progress& progress);
+  Status set_scales(const std::vector<ScalePoint>& scales, const Progress& progress);
+
+  // CG solve of (L + C) x = b for several right-hand sides (columns), warm-started; each column
+  // is an equal part of `progress`.
+  Result<Eigen::MatrixXd> cg_solve(const std::vector<Eigen::Triplet<double>>& cons, const Eigen::MatrixXd& b,
+                                   const Eigen::MatrixXd& guess, const Progress& progress) const {
+    if (progress.interrupted()) return cancelled();
     Eigen::SparseMatrix<double> c(n, n);
     c.setFromTriplets(cons.begin(), cons.end());
     Eigen::SparseMatrix<double> a = ltl + c;
-    Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper, Eigen::IncompleteCholesky<double>> cg;
+    Cg cg;
     cg.setTolerance(1e-13);
     cg.setMaxIterations(20000);
     cg.compute(a);
     Eigen::MatrixXd x(n, b.cols());
-    for (int k = 0; k < b.cols(); ++k) x.col(k) = cg.solveWithGuess(b.col(k), guess.col(k));
+    try {
+      for (int k = 0; k < b.cols(); ++k) {
+        const Progress column = progress.part(double(k) / double(b.cols()), double(k + 1) / double(b.cols()));
+        cg.preconditioner().progress = &column;
+        x.col(k) = cg.solveWithGuess(b.col(k), guess.col(k));
+        cg.preconditioner().progress = nullptr;
+      }
+    } catch (const Interrupted&) {
+      return cancelled();
+    }
     return x;
+  }
+
+  // What an incremental operation may change before it can fail; restore() undoes it.
+  struct Saved {
+    size_t constraints = 0;
+    std::vector<std::array<double, 4>> rhs;
+    std::vector<double> weight;
+    int curves = 0;
+  };
+  Saved save() const { return {constraint.size(), rhs, weight, curves}; }
+  void restore(Saved&& s) {
+    constraint.erase(constraint.begin() + std::ptrdiff_t(s.constraints), constraint.end());
+    rhs = std::move(s.rhs);
+    weight = std::move(s.weight);
+    curves = s.curves;
   }
 
   int index(int x, int y, int z) const { return (z * dims[1] + y) * dims[0] + x; }
@@ -171,16 +254,17 @@ struct FieldSolver::Impl {
     }
   }
 
-  Status solve(FieldSolveStats* stats) {
+  // Solves for the current constraints. Until the solution is complete nothing but (a first
+  // zero) raw_solution changes, so an interrupted solve leaves the previous field in place.
+  Status solve(FieldSolveStats* stats, const Progress& progress) {
+    if (progress.interrupted()) return cancelled();
     const auto t0 = std::chrono::steady_clock::now();
     Eigen::SparseMatrix<double> c(n, n);
     c.setFromTriplets(constraint.begin(), constraint.end());
     Eigen::SparseMatrix<double> a = ltl + c;
     // Conjugate gradients with an incomplete-Cholesky preconditioner, warm-started from the
     // previous solution (adding a curve changes little), to a tight relative tolerance.
-    Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper,
-                             Eigen::IncompleteCholesky<double>>
-        cg;
+    Cg cg;
     cg.setTolerance(1e-13);
     cg.setMaxIterations(20000);
     cg.compute(a);
@@ -190,9 +274,16 @@ struct FieldSolver::Impl {
     for (int i = 0; i < n; ++i)
       for (int c = 0; c < 4; ++c) b(i, c) = rhs[size_t(i)][size_t(c)];
     if (raw_solution.rows() != n) raw_solution = Eigen::MatrixXd::Zero(n, 4);
-    for (int c = 0; c < 4; ++c) {
-      Eigen::VectorXd col = cg.solveWithGuess(b.col(c), raw_solution.col(c));
-      q.col(c) = col;
+    try {
+      for (int c = 0; c < 4; ++c) {
+        const Progress column = progress.part(c / 4.0, (c + 1) / 4.0);
+        cg.preconditioner().progress = &column;
+        Eigen::VectorXd col = cg.solveWithGuess(b.col(c), raw_solution.col(c));
+        cg.preconditioner().progress = nullptr;
+        q.col(c) = col;
+      }
+    } catch (const Interrupted&) {
+      return cancelled();
     }
     raw_solution = q;
     const double bn = b.norm();
@@ -252,24 +343,37 @@ struct FieldSolver::Impl {
 FieldSolver::FieldSolver() : impl_(std::make_unique<Impl>()) {}
 FieldSolver::~FieldSolver() = default;
 
-Result<std::unique_ptr<FieldSolver>> FieldSolver::create(const SketchDomain& d) {
+Result<std::unique_ptr<FieldSolver>> FieldSolver::create(const SketchDomain& d, int64_t max_nodes) {
   const double ext[3] = {d.max.x - d.min.x, d.max.y - d.min.y, d.max.z - d.min.z};
   if (!(ext[0] > 0 && ext[1] > 0 && ext[2] > 0)) return Status(StatusCode::kInvalidArgument, "domain is empty", "domain");
+  if (!(std::isfinite(ext[0]) && std::isfinite(ext[1]) && std::isfinite(ext[2])))
+    return Status(StatusCode::kInvalidArgument, "domain is too large (its extent is not a finite number)", "domain");
   if (d.shortest_side_cells < 2 || d.shortest_side_cells > 256)
     return Status(StatusCode::kInvalidArgument, "must be in [2, 256]", "domain.shortest_side_cells");
+  const double spacing = std::min({ext[0], ext[1], ext[2]}) / d.shortest_side_cells;
+  // Node counts in double precision (exact for any grid under the limits, inf at worst), so
+  // that no extent overflows an integer before the limits are checked.
+  double count[3];
+  double total = 1;
+  for (int a = 0; a < 3; ++a) {
+    count[a] = std::ceil(ext[a] / spacing - 1e-9) + 1;
+    total *= count[a];
+  }
+  static_assert(kMaxNodes == 2'000'000, "the message below says 2M");
+  if (!(total <= double(kMaxNodes)))
+    return Status(StatusCode::kTooLarge, "the field grid would have " + node_count_text(count, total) + " nodes (limit 2M)",
+                  "domain.shortest_side_cells");
+  if (!(total <= double(max_nodes)))
+    return Status(StatusCode::kUnprocessable,
+                  "the field grid would have " + node_count_text(count, total) + " nodes; the limit is " +
+                      std::to_string(max_nodes) + " (lower shortest_side_cells or the domain's aspect)",
+                  "domain.shortest_side_cells");
   auto s = std::unique_ptr<FieldSolver>(new FieldSolver());
   Impl& m = *s->impl_;
   m.domain = d;
   m.origin = d.min;
-  m.spacing = std::min({ext[0], ext[1], ext[2]}) / d.shortest_side_cells;
-  int64_t total = 1;
-  for (int a = 0; a < 3; ++a) {
-    m.dims[size_t(a)] = int(std::ceil(ext[a] / m.spacing - 1e-9)) + 1;
-    total *= m.dims[size_t(a)];
-  }
-  if (total > 2'000'000)
-    return Status(StatusCode::kTooLarge, "the field grid would have " + std::to_string(total) + " nodes (limit 2M)",
-                  "domain.shortest_side_cells");
+  m.spacing = spacing;
+  for (int a = 0; a < 3; ++a) m.dims[size_t(a)] = int(count[a]);
   m.n = int(total);
   // The grid's combinatorial Laplacian (Dirichlet energy sum over edges of ||q_i - q_j||^2).
   std::vector<Eigen::Triplet<double>> trip;
@@ -298,8 +402,8 @@ Result<std::unique_ptr<FieldSolver>> FieldSolver::create(const SketchDomain& d) 
   return s;
 }
 
-Status FieldSolver::add_curve(const SketchCurve& c, int index, FieldSolveStats* stats) {
-  Impl& m = *impl_;
+Status FieldSolver::Impl::add_curve(const SketchCurve& c, int index, FieldSolveStats* stats, const Progress& progress) {
+  Impl& m = *this;
   SOLIDTEX_RETURN_IF_ERROR(validate_curve(c, m.domain, index));
   const bool first = m.curves == 0;
   const double w2 = c.weight * c.weight;
@@ -364,11 +468,12 @@ Status FieldSolver::add_curve(const SketchCurve& c, int index, FieldSolveStats* 
     }
   }
   ++m.curves;
-  return m.solve(stats);
+  return m.solve(stats, progress);
 }
 
-Status FieldSolver::add_frames(const std::vector<SketchFrame>& frames, FieldSolveStats* stats) {
-  Impl& m = *impl_;
+Status FieldSolver::Impl::add_frames(const std::vector<SketchFrame>& frames, FieldSolveStats* stats,
+                                     const Progress& progress) {
+  Impl& m = *this;
   if (frames.empty()) return Status::ok();
   const bool first = m.curves == 0;
   for (const SketchFrame& f : frames) {
@@ -378,30 +483,15 @@ Status FieldSolver::add_frames(const std::vector<SketchFrame>& frames, FieldSolv
     m.constrain(p, q, f.weight * f.weight);
   }
   ++m.curves;
-  return m.solve(stats);
+  return m.solve(stats, progress);
 }
 
-Result<std::unique_ptr<FieldSolver>> FieldSolver::solve(const Sketch& sketch, FieldSolveStats* stats) {
-  SOLIDTEX_ASSIGN_OR_RETURN(auto solver, create(sketch.domain));
-  const auto t0 = std::chrono::steady_clock::now();
-  SOLIDTEX_RETURN_IF_ERROR(solver->add_frames(sketch.frames, stats));
-  for (size_t i = 0; i < sketch.curves.size(); ++i) SOLIDTEX_RETURN_IF_ERROR(solver->add_curve(sketch.curves[i], int(i), stats));
-  SOLIDTEX_RETURN_IF_ERROR(solver->set_scales(sketch.scales));
-  if (stats) stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  return solver;
-}
-
-Result<std::shared_ptr<const QuatGridField>> FieldSolver::field() const {
-  if (impl_->curves == 0) return Status(StatusCode::kInvalidArgument, "the sketch has no curves", "curves");
-  return QuatGridField::create(impl_->origin, impl_->spacing, impl_->dims, impl_->solution, impl_->log_scales);
-}
-const std::vector<Quat>& FieldSolver::nodes() const { return impl_->solution; }
-const std::vector<std::array<double, 3>>& FieldSolver::log_scales() const { return impl_->log_scales; }
-
-Status FieldSolver::set_scales(const std::vector<ScalePoint>& scales) {
-  Impl& m = *impl_;
-  m.log_scales.clear();
-  if (scales.empty()) return Status::ok();
+Status FieldSolver::Impl::set_scales(const std::vector<ScalePoint>& scales, const Progress& progress) {
+  Impl& m = *this;
+  if (scales.empty()) {
+    m.log_scales.clear();
+    return Status::ok();
+  }
   std::vector<Eigen::Triplet<double>> cons;
   Eigen::MatrixXd b = Eigen::MatrixXd::Zero(m.n, 3);
   for (size_t i = 0; i < scales.size(); ++i) {
@@ -420,13 +510,63 @@ Status FieldSolver::set_scales(const std::vector<ScalePoint>& scales) {
         if (w[size_t(e)] != 0) cons.emplace_back(idx[size_t(c)], idx[size_t(e)], w2 * w[size_t(c)] * w[size_t(e)]);
     }
   }
-  const Eigen::MatrixXd x = m.cg_solve(cons, b, Eigen::MatrixXd::Zero(m.n, 3));
+  SOLIDTEX_ASSIGN_OR_RETURN(const Eigen::MatrixXd x, m.cg_solve(cons, b, Eigen::MatrixXd::Zero(m.n, 3), progress));
   m.log_scales.resize(size_t(m.n));
   for (int i = 0; i < m.n; ++i)
     for (int a = 0; a < 3; ++a)
       m.log_scales[size_t(i)][size_t(a)] = std::clamp(x(i, a), std::log(kMinScale), std::log(kMaxScale));
   return Status::ok();
 }
+
+Status FieldSolver::add_curve(const SketchCurve& curve, int index, FieldSolveStats* stats, Interrupter& interrupter) {
+  Task task(interrupter, "field solve");
+  Impl::Saved saved = impl_->save();
+  Status st = impl_->add_curve(curve, index, stats, Progress{&interrupter});
+  if (!st.is_ok()) impl_->restore(std::move(saved));
+  return st;
+}
+
+Status FieldSolver::add_frames(const std::vector<SketchFrame>& frames, FieldSolveStats* stats, Interrupter& interrupter) {
+  Task task(interrupter, "field solve");
+  Impl::Saved saved = impl_->save();
+  Status st = impl_->add_frames(frames, stats, Progress{&interrupter});
+  if (!st.is_ok()) impl_->restore(std::move(saved));
+  return st;
+}
+
+Status FieldSolver::set_scales(const std::vector<ScalePoint>& scales, Interrupter& interrupter) {
+  Task task(interrupter, "field solve");
+  return impl_->set_scales(scales, Progress{&interrupter});  // changes nothing unless it succeeds
+}
+
+Result<std::unique_ptr<FieldSolver>> FieldSolver::solve(const Sketch& sketch, FieldSolveStats* stats,
+                                                        Interrupter& interrupter, int64_t max_nodes) {
+  SOLIDTEX_ASSIGN_OR_RETURN(auto solver, create(sketch.domain, max_nodes));
+  Task task(interrupter, "field solve");
+  Impl& m = *solver->impl_;
+  const auto t0 = std::chrono::steady_clock::now();
+  // Each linear solve (the frames, every curve, the scales) is an equal share of the progress.
+  const size_t steps = (sketch.frames.empty() ? 0 : 1) + sketch.curves.size() + (sketch.scales.empty() ? 0 : 1);
+  size_t step = 0;
+  auto next = [&] {
+    const Progress p = Progress{&interrupter}.part(double(step) / double(steps), double(step + 1) / double(steps));
+    ++step;
+    return p;
+  };
+  if (!sketch.frames.empty()) SOLIDTEX_RETURN_IF_ERROR(m.add_frames(sketch.frames, stats, next()));
+  for (size_t i = 0; i < sketch.curves.size(); ++i) SOLIDTEX_RETURN_IF_ERROR(m.add_curve(sketch.curves[i], int(i), stats, next()));
+  if (!sketch.scales.empty()) SOLIDTEX_RETURN_IF_ERROR(m.set_scales(sketch.scales, next()));
+  if (stats) stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return solver;
+}
+
+Result<std::shared_ptr<const QuatGridField>> FieldSolver::field() const {
+  if (impl_->curves == 0) return Status(StatusCode::kInvalidArgument, "the sketch has no curves", "curves");
+  return QuatGridField::create(impl_->origin, impl_->spacing, impl_->dims, impl_->solution, impl_->log_scales);
+}
+const std::vector<Quat>& FieldSolver::nodes() const { return impl_->solution; }
+const std::vector<std::array<double, 3>>& FieldSolver::log_scales() const { return impl_->log_scales; }
+
 std::array<int, 3> FieldSolver::dims() const { return impl_->dims; }
 WorldPoint FieldSolver::origin() const { return impl_->origin; }
 double FieldSolver::spacing() const { return impl_->spacing; }

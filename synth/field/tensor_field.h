@@ -17,15 +17,21 @@
 // Nodes whose solution vanishes (|q| < 1e-9) copy a neighbour's frame and count as singular.
 // Adding a curve re-solves the same system with the new constraints: the result is exactly the
 // full solve with all curves.
+// Long operations take an Interrupter (core/interrupter.h), polled before every linear solve
+// and at every conjugate-gradient iteration; when it asks to stop they return kCancelled and
+// leave the solver as it was before the call. Grid sizes are checked before anything is
+// allocated (create()).
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <memory>
 #include <vector>
 
+#include "core/interrupter.h"
+#include "core/status.h"
 #include "field/frame_field.h"
 #include "field/sketch.h"
-#include "core/status.h"
 
 namespace solidtex {
 
@@ -39,18 +45,34 @@ struct FieldSolveStats {
 
 class FieldSolver {
  public:
-  static Result<std::unique_ptr<FieldSolver>> create(const SketchDomain& domain);
+  // The most grid nodes any solver accepts, whatever the caller's own limit.
+  static constexpr int64_t kMaxNodes = 2'000'000;
+
+  // An empty field over `domain`. Errors, all before anything is allocated: kInvalidArgument
+  // for an empty or non-finite domain or shortest_side_cells outside [2, 256]; kTooLarge when
+  // the grid would exceed kMaxNodes, kUnprocessable when it would exceed `max_nodes` (both
+  // naming "domain.shortest_side_cells"). Grid dimensions are computed overflow-free, so an
+  // extreme aspect (e.g. max [1.1e9, 1, 1]) is just a grid with too many nodes.
+  static Result<std::unique_ptr<FieldSolver>> create(const SketchDomain& domain, int64_t max_nodes = kMaxNodes);
   ~FieldSolver();
 
+  // The incremental operations below leave the solver unchanged when they fail (invalid input
+  // or cancellation), so a caller may keep using it.
   // Adds a validated curve and re-solves. `index` is only used in error messages.
-  Status add_curve(const SketchCurve& curve, int index, FieldSolveStats* stats = nullptr);
+  Status add_curve(const SketchCurve& curve, int index, FieldSolveStats* stats = nullptr,
+                   Interrupter& interrupter = null_interrupter());
   // Adds explicit frames (signs as given) in one batch and re-solves once; a first batch
   // counts as the field's first "curve" (later unlabelled curves align to it).
-  Status add_frames(const std::vector<SketchFrame>& frames, FieldSolveStats* stats = nullptr);
+  Status add_frames(const std::vector<SketchFrame>& frames, FieldSolveStats* stats = nullptr,
+                    Interrupter& interrupter = null_interrupter());
   // Sets the sparse scale points (replacing earlier ones) and solves the log-scale field.
-  Status set_scales(const std::vector<ScalePoint>& scales);
-  // Solves a whole sketch: every curve in order, then the scales.
-  static Result<std::unique_ptr<FieldSolver>> solve(const Sketch& sketch, FieldSolveStats* stats = nullptr);
+  Status set_scales(const std::vector<ScalePoint>& scales, Interrupter& interrupter = null_interrupter());
+  // Solves a whole sketch: the frames, every curve in order, then the scales. Progress is
+  // reported as the share of those steps done; `stats` describes the last linear solve, with
+  // `seconds` the whole solve (grid set-up excluded). Errors as create() and the steps above.
+  static Result<std::unique_ptr<FieldSolver>> solve(const Sketch& sketch, FieldSolveStats* stats = nullptr,
+                                                    Interrupter& interrupter = null_interrupter(),
+                                                    int64_t max_nodes = kMaxNodes);
 
   // The normalised field (trilinear, sign-aligned corners). Requires at least one curve.
   Result<std::shared_ptr<const QuatGridField>> field() const;
