@@ -1,5 +1,6 @@
 #include "exemplar_service.h"
 
+#include <algorithm>
 #include <chrono>
 #include <condition_variable>
 #include <deque>
@@ -41,7 +42,12 @@ struct Entry {
   int64_t table_bytes = 0;
   double seconds = 0;
   std::shared_ptr<const Table> table;
+  bool cancel = false;  // DELETE while running: the analysis stops, then the exemplar goes
 };
+
+// An acknowledged analysis runs again after a restart; one that was running when the
+// process died twice (a poison pill) is marked failed instead of crash-looping the server.
+constexpr int kMaxAnalysisAttempts = 2;
 
 }  // namespace
 
@@ -50,6 +56,7 @@ struct ExemplarService::Impl {
   ServerConfig config;
   mutable std::mutex mutex;
   std::condition_variable wake;
+  std::condition_variable finished;  // a running analysis ended (DELETE waits on it)
   std::map<std::string, Entry> entries;
   std::deque<std::string> pending;
   std::vector<std::thread> threads;
@@ -121,7 +128,9 @@ struct ExemplarService::Impl {
         auto it = impl_.entries.find(id_);
         if (it != impl_.entries.end()) it->second.percent = std::min(percent, 99);
       }
-      return impl_.stopping.load();
+      std::lock_guard<std::mutex> g(impl_.mutex);
+      auto it = impl_.entries.find(id_);
+      return impl_.stopping.load() || (it != impl_.entries.end() && it->second.cancel);
     }
 
    private:
@@ -129,12 +138,25 @@ struct ExemplarService::Impl {
     std::string id_;
   };
 
+  int attempts(const std::string& id) const {
+    auto text = store.read_text(ResourceKind::kExemplar, id, "attempts");
+    if (!text) return 0;
+    try {
+      return std::stoi(*text);
+    } catch (...) {
+      return kMaxAnalysisAttempts;  // unreadable marker: treat as exhausted, never crash-loop
+    }
+  }
+
   void run_analysis(const std::string& id) {
     json meta;
     {
       std::lock_guard<std::mutex> g(mutex);
       meta = entries.at(id).meta;
     }
+    // Durable before the work starts, so a crash during it is counted at the next start.
+    const int attempt = attempts(id) + 1;
+    (void)store.write_text(ResourceKind::kExemplar, id, "attempts", std::to_string(attempt));
     const auto t0 = std::chrono::steady_clock::now();
     auto result = [&]() -> Result<json> {
       std::vector<std::pair<std::string, std::vector<uint8_t>>> parts;
@@ -152,7 +174,15 @@ struct ExemplarService::Impl {
       return json{{"levels", to_json(r.levels)}, {"table_bytes", int64_t(bytes.size())}, {"seconds", r.seconds}};
     }();
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    if (!result && stopping.load()) return;  // abandoned: runs again at the next start
+    if (!result && stopping.load()) {  // abandoned by a clean shutdown: runs again, uncounted
+      (void)store.write_text(ResourceKind::kExemplar, id, "attempts", std::to_string(attempt - 1));
+      return;
+    }
+    {
+      std::lock_guard<std::mutex> g(mutex);
+      auto it = entries.find(id);
+      if (it != entries.end() && it->second.cancel) return;  // DELETE removes it
+    }
     json record = result ? *result : json{{"error", status_json(result.status())}, {"seconds", seconds}};
     // An exemplar deleted meanwhile has no directory any more; the write then fails harmlessly.
     Status st = store.write_text(ResourceKind::kExemplar, id, "result.json", record.dump());
@@ -196,6 +226,10 @@ struct ExemplarService::Impl {
       run_analysis(id);
       std::lock_guard<std::mutex> g(mutex);
       --running;
+      auto it = entries.find(id);
+      if (it != entries.end() && it->second.state == State::kRunning && it->second.cancel)
+        it->second.state = State::kFailed;  // cancelled; the waiting DELETE removes it
+      finished.notify_all();
     }
   }
 };
@@ -224,6 +258,13 @@ Status ExemplarService::start(std::vector<std::string>* report) {
         e.state = State::kFailed;
         e.error = record.status();
       }
+    } else if (impl_->attempts(id) >= kMaxAnalysisAttempts) {
+      const json record{{"error", status_json(Status(StatusCode::kInternal,
+                                                     "the analysis was interrupted " + std::to_string(kMaxAnalysisAttempts) +
+                                                         " times by a server crash; it is not retried"))}};
+      (void)impl_->store.write_text(ResourceKind::kExemplar, id, "result.json", record.dump());
+      impl_->apply_result(e, record);
+      if (report) report->push_back("marked the analysis of exemplar " + id + " failed: it crashed the server before");
     } else {
       impl_->pending.push_back(id);
       if (report) report->push_back("re-queued the analysis of exemplar " + id);
@@ -317,11 +358,22 @@ Result<json> ExemplarService::job(const std::string& job_id) const {
 }
 
 Status ExemplarService::remove(const std::string& id, const std::function<bool(const std::string&)>& in_use) {
-  std::lock_guard<std::mutex> g(impl_->mutex);
+  std::unique_lock<std::mutex> g(impl_->mutex);
   auto it = impl_->entries.find(id);
   if (it == impl_->entries.end()) return Status(StatusCode::kNotFound, "no exemplar '" + id + "'", "id");
-  if (it->second.state == State::kQueued || it->second.state == State::kRunning)
-    return Status(StatusCode::kFailedPrecondition, "exemplar '" + id + "' is still being analysed", "id");
+  if (it->second.state == State::kQueued) {  // never started: just drop it from the queue
+    auto& q = impl_->pending;
+    q.erase(std::remove(q.begin(), q.end(), id), q.end());
+  } else if (it->second.state == State::kRunning) {  // cancel, and wait until the worker lets go
+    it->second.cancel = true;
+    const bool ended = impl_->finished.wait_for(g, std::chrono::seconds(30), [&] {
+      auto e = impl_->entries.find(id);
+      return e == impl_->entries.end() || e->second.state != State::kRunning;
+    });
+    if (!ended) return Status(StatusCode::kResourceExhausted, "the analysis of '" + id + "' is still stopping; retry", "id");
+    it = impl_->entries.find(id);
+    if (it == impl_->entries.end()) return Status::ok();
+  }
   if (in_use(id)) return Status(StatusCode::kFailedPrecondition, "exemplar '" + id + "' is used by a volume", "id");
   SOLIDTEX_RETURN_IF_ERROR(impl_->store.remove(ResourceKind::kExemplar, id));
   impl_->entries.erase(it);

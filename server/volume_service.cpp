@@ -156,7 +156,8 @@ struct VolumeService::Impl {
         }
       }
     }
-    if (spec != "identity" || !j.contains("field")) {
+    const bool stored_field = j.contains("field") && j["field"].contains("id");
+    if (!stored_field) {  // inline spec, or identity by default
       auto parsed = parse_field_spec(spec);
       if (!parsed) return Status(StatusCode::kInvalidArgument, parsed.status().message(), "field.spec");
       v->field = *parsed;

@@ -6,6 +6,15 @@
 namespace solidtex {
 namespace {
 
+Status check_values(const ImageF& img, const char* field) {
+  for (const float v : img.pixels)
+    if (!(std::fabs(v) <= kMaxExemplarValue))  // also false for NaN
+      return Status(StatusCode::kInvalidArgument,
+                    "has a pixel value of " + std::to_string(v) + "; values must be finite with magnitude at most 65504",
+                    field);
+  return Status::ok();
+}
+
 Status check_exemplar(const ImageF& img, const char* field) {
   if (img.empty()) return Status(StatusCode::kInvalidArgument, "image is empty", field);
   if (img.channels != 3) return Status(StatusCode::kInvalidArgument, "expected linear RGB (3 channels)", field);
@@ -14,12 +23,13 @@ Status check_exemplar(const ImageF& img, const char* field) {
                   "is " + std::to_string(img.width) + "x" + std::to_string(img.height) +
                       "; exemplars need at least " + std::to_string(kMinExemplarSide) + " pixels per side",
                   field);
-  return Status::ok();
+  return check_values(img, field);
 }
 
 Result<std::shared_ptr<const ImageF>> matching_image(const ImageF& rgb, const std::optional<ImageF>& mask,
                                                      float weight, const char* mask_field) {
   if (!mask) return std::make_shared<const ImageF>(rgb);
+  SOLIDTEX_RETURN_IF_ERROR(check_values(*mask, mask_field));
   if (mask->width != rgb.width || mask->height != rgb.height)
     return Status(StatusCode::kInvalidArgument,
                   "is " + std::to_string(mask->width) + "x" + std::to_string(mask->height) +

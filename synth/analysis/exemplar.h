@@ -17,6 +17,9 @@
 namespace solidtex {
 
 inline constexpr int kMinExemplarSide = 8;
+// Largest |value| of an exemplar or mask pixel (the largest half float): larger values overflow
+// the squared neighborhood distances of matching to infinity.
+inline constexpr float kMaxExemplarValue = 65504.f;
 
 struct ExemplarInputs {
   ImageF xy;                          // required; linear RGB

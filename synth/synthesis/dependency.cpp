@@ -11,21 +11,6 @@ namespace {
 
 Voxel add(const Voxel& p, const std::array<int8_t, 3>& o) { return {p.x + o[0], p.y + o[1], p.z + o[2]}; }
 
-// Level boxes, finest first: a level's sets stay within its final-version box dilated by the
-// number of steps times the reach; the parents of that box bound the coarser final version.
-std::vector<VoxelBox> level_boxes(const DependencyInputs& in, const TargetSet& target) {
-  const int L = in.stencils->levels();
-  std::vector<VoxelBox> boxes(static_cast<size_t>(L));
-  VoxelBox final_box = target.bounds();
-  for (int l = L - 1; l >= 0; --l) {
-    const int radius = (*in.schedules)[size_t(l)].final_version() * in.stencils->reach(PyramidLevel{l});
-    boxes[size_t(l)] = final_box.dilated(radius);
-    const VoxelBox& b = boxes[size_t(l)];
-    final_box = {parent_of(b.lo), {floor_div(b.hi.x - 1, 2) + 1, floor_div(b.hi.y - 1, 2) + 1, floor_div(b.hi.z - 1, 2) + 1}};
-  }
-  return boxes;
-}
-
 // Splits the final-version needs into cache hits and the set to synthesize.
 void take_cached(VoxelCache* cache, PyramidLevel l, const std::vector<Voxel>& final_need, LevelDependencies& dep,
                  VoxelMask& final_set) {
@@ -46,12 +31,13 @@ void take_cached(VoxelCache* cache, PyramidLevel l, const std::vector<Voxel>& fi
 // versions; the others carry down to v - 1. Returns the number of updates, or an error when a
 // read escapes the level box.
 Result<int64_t> step_back(const FrameStencils& stencils, PyramidLevel l, const CorrectionStep& step,
-                          LevelDependencies& dep, int v) {
+                          LevelDependencies& dep, int v, LatchedInterrupter& interrupter) {
   const std::vector<Voxel> members = dep.needed[size_t(v)].to_vector();
   std::atomic<int64_t> updated{0};
   std::atomic<bool> escaped{false};
   // Set union is order-independent, so the parallel inserts give the same sets.
   tbb::parallel_for(tbb::blocked_range<size_t>(0, members.size(), 512), [&](const tbb::blocked_range<size_t>& r) {
+    if (interrupter.poll()) return;  // deadlines hold inside a step, not only between steps
     ReadStencil stencil;
     FrameStencils::Offsets offsets;
     int64_t local_updates = 0;
@@ -74,6 +60,7 @@ Result<int64_t> step_back(const FrameStencils& stencils, PyramidLevel l, const C
     }
     updated += local_updates;
   });
+  if (interrupter.stopped()) return Status(StatusCode::kCancelled, "synthesis cancelled");
   if (escaped) return Status(StatusCode::kInternal, "dependency escaped its bounding box (stencil reach too small)");
   return updated.load();
 }
@@ -89,10 +76,26 @@ std::vector<Voxel> parents_of(const VoxelMask& set) {
 
 }  // namespace
 
+// Level boxes, finest first: a level's sets stay within its final-version box dilated by the
+// number of steps times the reach; the parents of that box bound the coarser final version.
+std::vector<VoxelBox> dependency_boxes(const std::vector<LevelSchedule>& schedules, const FrameStencils& stencils,
+                                       const VoxelBox& target_bounds) {
+  const int L = stencils.levels();
+  std::vector<VoxelBox> boxes(static_cast<size_t>(L));
+  VoxelBox final_box = target_bounds;
+  for (int l = L - 1; l >= 0; --l) {
+    const int radius = schedules[size_t(l)].final_version() * stencils.reach(PyramidLevel{l});
+    boxes[size_t(l)] = final_box.dilated(radius);
+    const VoxelBox& b = boxes[size_t(l)];
+    final_box = {parent_of(b.lo), {floor_div(b.hi.x - 1, 2) + 1, floor_div(b.hi.y - 1, 2) + 1, floor_div(b.hi.z - 1, 2) + 1}};
+  }
+  return boxes;
+}
+
 Result<std::vector<LevelDependencies>> analyze_dependencies(const DependencyInputs& in, const TargetSet& target,
                                                             LatchedInterrupter& interrupter) {
   const int L = in.stencils->levels();
-  const std::vector<VoxelBox> boxes = level_boxes(in, target);
+  const std::vector<VoxelBox> boxes = dependency_boxes(*in.schedules, *in.stencils, target.bounds());
   std::vector<LevelDependencies> deps(static_cast<size_t>(L));
   std::vector<Voxel> final_need = target.voxels;
   for (int l = L - 1; l >= 0; --l) {
@@ -106,7 +109,7 @@ Result<std::vector<LevelDependencies>> analyze_dependencies(const DependencyInpu
     for (int v = V; v >= 1; --v) {
       if (interrupter.poll()) return Status(StatusCode::kCancelled, "synthesis cancelled");
       SOLIDTEX_ASSIGN_OR_RETURN(const int64_t updates,
-                                step_back(*in.stencils, PyramidLevel{l}, sch.steps()[size_t(v - 1)], dep, v));
+                                step_back(*in.stencils, PyramidLevel{l}, sch.steps()[size_t(v - 1)], dep, v, interrupter));
       dep.corrections += updates;
     }
     if (l > 0) final_need = parents_of(dep.needed[0]);

@@ -47,6 +47,10 @@ struct DependencyInputs {
 Result<std::vector<LevelDependencies>> analyze_dependencies(const DependencyInputs& in, const TargetSet& target,
                                                             LatchedInterrupter& interrupter);
 
+// The box every set of each level lies in (index = level), from the target's bounds.
+std::vector<VoxelBox> dependency_boxes(const std::vector<LevelSchedule>& schedules, const FrameStencils& stencils,
+                                       const VoxelBox& target_bounds);
+
 // The parent (one level coarser) of voxel p.
 inline Voxel parent_of(const Voxel& p) { return {floor_div(p.x, 2), floor_div(p.y, 2), floor_div(p.z, 2)}; }
 

@@ -25,16 +25,20 @@ class LevelStore {
   LevelStore(const VoxelBox& box, int slots);
   void allocate(const Voxel& p);  // single-threaded, before synthesis
   bool has(const Voxel& p) const;
+  // Null when p lies outside the box or in a brick not allocated.
+  const VoxelState* find(const Voxel& p, int slot) const { return has(p) ? &at(p, slot) : nullptr; }
   VoxelState& at(const Voxel& p, int slot) { return brick(p)->states[index(p, slot)]; }
   const VoxelState& at(const Voxel& p, int slot) const { return brick(p)->states[index(p, slot)]; }
   uint8_t flags(const Voxel& p, int slot) const;
   void set_flag(const Voxel& p, int slot, uint8_t f);  // thread-safe (atomic or)
   int slots() const { return slots_; }
 
-  // The 3x3x3 bricks around voxel p, looked up once, so that reads at offsets up to +-8
-  // cost no table lookups. Missing bricks are null.
+  // The 3x3x3 bricks around voxel p, looked up once, so that reads at offsets up to +-kReach
+  // cost no table lookups. Missing bricks are null. Callers whose stencils reach further use
+  // at() (the synthesizer picks the path per level from the stencil reach).
   class Neighborhood {
    public:
+    static constexpr int kReach = 8;
     Neighborhood(const LevelStore& store, const Voxel& p) : p_(p), slots_(store.slots_) {
       for (int z = -1; z <= 1; ++z)
         for (int y = -1; y <= 1; ++y)
@@ -43,10 +47,13 @@ class LevelStore {
             near_[size_t((z + 1) * 9 + (y + 1) * 3 + (x + 1))] = b >= 0 ? store.table_[size_t(b)] : nullptr;
           }
     }
-    const VoxelState& at(int dx, int dy, int dz, int slot) const {
+    // |dx|, |dy|, |dz| <= kReach; the brick of p + (dx, dy, dz) must be allocated.
+    const VoxelState& at(int dx, int dy, int dz, int slot) const { return *find(dx, dy, dz, slot); }
+    // Null when the brick of p + (dx, dy, dz) is not allocated.
+    const VoxelState* find(int dx, int dy, int dz, int slot) const {
       const int lx = (p_.x & 7) + dx, ly = (p_.y & 7) + dy, lz = (p_.z & 7) + dz;
       const Brick* b = near_[size_t(((lz >> 3) + 1) * 9 + ((ly >> 3) + 1) * 3 + ((lx >> 3) + 1))];
-      return b->states[size_t((lx & 7) + 8 * (ly & 7) + 64 * (lz & 7)) * slots_ + slot];
+      return b ? &b->states[size_t((lx & 7) + 8 * (ly & 7) + 64 * (lz & 7)) * slots_ + slot] : nullptr;
     }
 
    private:

@@ -8,6 +8,7 @@
 #include <chrono>
 
 #include "synthesis/correction.h"
+#include "synthesis/cost_model.h"
 #include "synthesis/dependency.h"
 #include "synthesis/frame_stencils.h"
 #include "synthesis/level_store.h"
@@ -73,6 +74,41 @@ class SetChecks {
   int64_t unread_ = 0;
 };
 
+// Targets whose voxels lie farther apart than this (finest voxels, 26-connected cells) are
+// synthesized piece by piece: one piece's dependency sets never span the gap between them.
+constexpr int kPieceCell = 256;
+
+TargetSet piece_target(const TargetSet& target, const std::vector<uint32_t>& piece) {
+  std::vector<Voxel> voxels;
+  voxels.reserve(piece.size());
+  for (uint32_t i : piece) voxels.push_back(target.voxels[i]);
+  return TargetSet::from_voxels(voxels, int(voxels.size()), 1);
+}
+
+Status too_much_memory(int64_t bytes, int64_t limit) {
+  return Status(StatusCode::kUnprocessable,
+                "this request needs up to " + std::to_string(bytes >> 20) + " MB of working memory; the limit is " +
+                    std::to_string(limit >> 20) + " MB (ask for a smaller or thinner cut or box, or closer points)",
+                "size");
+}
+
+void add_stats(SynthesisStats& into, const SynthesisStats& piece) {
+  for (size_t l = 0; l < into.levels.size(); ++l) {
+    LevelStats& a = into.levels[l];
+    const LevelStats& b = piece.levels[l];
+    a.level = b.level;
+    a.voxels += b.voxels;
+    a.corrections += b.corrections;
+    a.cache_hits += b.cache_hits;
+    a.needed_final += b.needed_final;
+    a.seconds += b.seconds;
+  }
+  into.dependency_seconds += piece.dependency_seconds;
+  into.store_bytes = std::max(into.store_bytes, piece.store_bytes);
+  into.unsound_reads += piece.unsound_reads;
+  into.unread_required += piece.unread_required;
+}
+
 // Everything one level's forward pass reads.
 struct LevelPass {
   PyramidLevel level;
@@ -102,12 +138,13 @@ std::unique_ptr<LevelStore> make_level_store(const LevelPass& pass, const LevelD
 
 // Version 0 of every voxel of the level's version-0 set: initialisation at the coarsest level,
 // upsampling from the parent's final version elsewhere (pyramid_init.h).
-void initialise_level(const LevelPass& pass, const LevelDependencies& dep, LevelStore& store,
+Status initialise_level(const LevelPass& pass, const LevelDependencies& dep, LevelStore& store,
                       const LevelSchedule* parent_sch, LevelStore* parent_store, SetChecks& checks) {
   const PyramidLevel l = pass.level;
   const CorrectionContext& ctx = pass.ctx;
   const FrameStencils& frames = pass.frames;
   const std::vector<Voxel> voxels = dep.needed[0].to_vector();
+  std::atomic<bool> missing_parent{false};
   tbb::parallel_for(tbb::blocked_range<size_t>(0, voxels.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t i = r.begin(); i != r.end(); ++i) {
       const Voxel& p = voxels[i];
@@ -119,11 +156,18 @@ void initialise_level(const LevelPass& pass, const LevelDependencies& dep, Level
         const PyramidLevel pl{l.index - 1};
         const int pslot = parent_sch->slot(P, parent_sch->final_version());
         if (!checks.read(*parent_store, P, pslot)) continue;
-        s.triple = upsample_triple(pass.table, l, p, parent_store->at(P, pslot).triple, frames.rotation(pl, P));
+        const VoxelState* parent = parent_store->find(P, pslot);
+        if (!parent) {
+          missing_parent = true;
+          continue;
+        }
+        s.triple = upsample_triple(pass.table, l, p, parent->triple, frames.rotation(pl, P));
       }
       matching_color(*ctx.level, s.triple, ctx.channels, ctx.color_weights, s.color.data());
     }
   });
+  if (missing_parent) return Status(StatusCode::kInternal, "an upsampled voxel's parent is outside the coarser level's sets");
+  return Status::ok();
 }
 
 // The level's correction steps, each on exactly the voxels of its set that it updates.
@@ -135,14 +179,18 @@ Status correct_level(const LevelPass& pass, const LevelDependencies& dep, LevelS
   const FrameStencils& frames = pass.frames;
   const int V = sch.final_version();
   const int L = pass.table.levels();
+  // Stretched fields (scales > ~1.4 at N = 9) reach past the 27 bricks Neighborhood caches.
+  const bool near_reaches = frames.reach(l) <= LevelStore::Neighborhood::kReach;
   for (int v = 1; v <= V; ++v) {
     const int percent = int(100.0 * (l.index + double(v) / (V + 1)) / L);
     if (poller.poll(percent)) return Status(StatusCode::kCancelled, "synthesis cancelled");
     const CorrectionStep& step = sch.steps()[size_t(v - 1)];
+    std::atomic<bool> outside_store{false};
     std::vector<Voxel> updates;
     for (const Voxel& p : dep.needed[size_t(v)].to_vector())
       if (step.updates.contains(p)) updates.push_back(p);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, updates.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
+      if (poller.poll(percent)) return;  // a step can take seconds: deadlines hold inside it
       CorrectionScratch scratch;
       ReadStencil local;
       for (size_t i = r.begin(); i != r.end(); ++i) {
@@ -154,13 +202,21 @@ Status correct_level(const LevelPass& pass, const LevelDependencies& dep, LevelS
           const Voxel q{p.x + dx, p.y + dy, p.z + dz};
           const int slot = sch.slot(q, window.version_of(q));
           if (!checks.read(store, q, slot)) return dummy_state();
-          return near.at(dx, dy, dz, slot);
+          const VoxelState* s = near_reaches ? near.find(dx, dy, dz, slot) : store.find(q, slot);
+          if (!s) {  // outside the sets: a dependency-analysis bug, never a wild read
+            outside_store = true;
+            return dummy_state();
+          }
+          return *s;
         };
         VoxelState& out = store.at(p, sch.slot(p, v));
         out.triple = correct_voxel(ctx, st, read, scratch);
         matching_color(*ctx.level, out.triple, ctx.channels, ctx.color_weights, out.color.data());
       }
     });
+    if (poller.stopped()) return Status(StatusCode::kCancelled, "synthesis cancelled");
+    if (outside_store)
+      return Status(StatusCode::kInternal, "a correction read a voxel outside the level's dependency sets");
   }
   return Status::ok();
 }
@@ -202,35 +258,30 @@ Result<std::shared_ptr<Synthesizer>> Synthesizer::create(std::shared_ptr<const T
   return s;
 }
 
-Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize(const TargetSet& target, Interrupter& interrupter,
-                                                                  SynthesisStats* stats_out,
-                                                                  const SynthesisOptions& options) {
-  const auto t_start = Clock::now();
-  if (target.voxels.empty()) return Status(StatusCode::kInvalidArgument, "the request selects no voxels", "target");
+RequestCost Synthesizer::estimate(const TargetSet& target) const {
+  const auto pieces = split_target(target, kPieceCell);
+  if (pieces.size() == 1) return estimate_cost(schedules_, impl_->stencils, target);
+  RequestCost worst;
+  for (const auto& piece : pieces) {
+    RequestCost c = estimate_cost(schedules_, impl_->stencils, piece_target(target, piece));
+    if (c.bytes > worst.bytes) worst = std::move(c);
+  }
+  return worst;
+}
+
+Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize_piece(const TargetSet& target,
+                                                                        LatchedInterrupter& poller, SynthesisStats& stats,
+                                                                        const SynthesisOptions& options) {
   const int L = table_->levels();
-  SynthesisStats stats;
-  stats.levels.resize(size_t(L));
-  LatchedInterrupter poller(interrupter);
-  interrupter.start("synthesize");
-  auto finish = [&]() {
-    interrupter.end();
-    for (const LevelStats& ls : stats.levels) {
-      stats.voxels += ls.voxels;
-      stats.corrections += ls.corrections;
-    }
-    stats.seconds = since(t_start);
-    if (stats_out) *stats_out = std::move(stats);
-  };
+  if (options.max_bytes > 0) {
+    const RequestCost cost = estimate_cost(schedules_, impl_->stencils, target);
+    if (cost.bytes > options.max_bytes) return too_much_memory(cost.bytes, options.max_bytes);
+  }
 
   // Backwards: what the target depends on.
   const auto t_dep = Clock::now();
   const DependencyInputs inputs{&schedules_, &impl_->stencils, options.use_cache ? cache_.get() : nullptr};
-  auto analysed = analyze_dependencies(inputs, target, poller);
-  if (!analysed.is_ok()) {
-    interrupter.end();
-    return analysed.status();
-  }
-  const std::vector<LevelDependencies>& deps = *analysed;
+  SOLIDTEX_ASSIGN_OR_RETURN(const std::vector<LevelDependencies> deps, analyze_dependencies(inputs, target, poller));
   for (int l = 0; l < L; ++l) {
     LevelStats& ls = stats.levels[size_t(l)];
     ls.level = l;
@@ -240,9 +291,10 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize(const TargetSe
     ls.voxels = deps[size_t(l)].needed[0].count();
   }
   stats.dependency_seconds = since(t_dep);
-  if (options.dependencies_only) {
-    finish();
-    return std::vector<std::array<float, 3>>{};
+  if (options.dependencies_only) return std::vector<std::array<float, 3>>{};
+  if (options.max_bytes > 0) {
+    const int64_t bytes = store_bytes(schedules_, deps);
+    if (bytes > options.max_bytes) return too_much_memory(bytes, options.max_bytes);
   }
 
   // Forwards, coarsest level first, inside the sets.
@@ -255,14 +307,11 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize(const TargetSe
     const LevelPass pass{level, *table_, params_, schedules_[size_t(l)], impl_->contexts[size_t(l)], impl_->stencils};
     std::unique_ptr<LevelStore> store = make_level_store(pass, dep);
     checks.mark_required(pass.schedule, dep, *store);
-    initialise_level(pass, dep, *store, l > 0 ? &schedules_[size_t(l - 1)] : nullptr, parent.get(), checks);
+    SOLIDTEX_RETURN_IF_ERROR(
+        initialise_level(pass, dep, *store, l > 0 ? &schedules_[size_t(l - 1)] : nullptr, parent.get(), checks));
     if (parent) checks.count_unread(schedules_[size_t(l - 1)], deps[size_t(l - 1)], *parent);
     parent.reset();
-    const Status corrected = correct_level(pass, dep, *store, checks, poller);
-    if (!corrected.is_ok()) {
-      interrupter.end();
-      return corrected;
-    }
+    SOLIDTEX_RETURN_IF_ERROR(correct_level(pass, dep, *store, checks, poller));
     if (options.use_cache) write_back(pass, dep, *store, *cache_);
     stats.store_bytes = std::max(stats.store_bytes, store->bytes());
     stats.levels[size_t(l)].seconds = since(t_level);
@@ -281,12 +330,54 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize(const TargetSe
     output_color(*table_, parent->at(p, slot).triple, fctx.color_weights, voxel_rgb[i].data());
   }
   checks.count_unread(fsch, deps[size_t(finest.index)], *parent);
-  std::vector<std::array<float, 3>> out(target.sample.size());
-  for (size_t i = 0; i < target.sample.size(); ++i) out[i] = voxel_rgb[target.sample[i]];
-
   stats.unsound_reads = checks.unsound();
   stats.unread_required = checks.unread();
-  finish();
+  return voxel_rgb;
+}
+
+Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize(const TargetSet& target, Interrupter& interrupter,
+                                                                  SynthesisStats* stats_out,
+                                                                  const SynthesisOptions& options) {
+  const auto t_start = Clock::now();
+  if (target.voxels.empty()) return Status(StatusCode::kInvalidArgument, "the request selects no voxels", "target");
+  const int L = table_->levels();
+  SynthesisStats stats;
+  stats.levels.resize(size_t(L));
+  LatchedInterrupter poller(interrupter);
+  interrupter.start("synthesize");
+
+  // Scattered targets go piece by piece (by purity, the same bits as one pass would give).
+  const auto pieces = split_target(target, kPieceCell);
+  std::vector<std::array<float, 3>> voxel_rgb;
+  for (const auto& piece : pieces) {
+    SynthesisStats ps;
+    ps.levels.resize(size_t(L));
+    auto colors = pieces.size() == 1 ? synthesize_piece(target, poller, ps, options)
+                                     : synthesize_piece(piece_target(target, piece), poller, ps, options);
+    if (!colors.is_ok()) {
+      interrupter.end();
+      return colors.status();
+    }
+    if (pieces.size() == 1) {
+      voxel_rgb = std::move(*colors);
+    } else if (!options.dependencies_only) {
+      voxel_rgb.resize(target.voxels.size());
+      for (size_t i = 0; i < piece.size(); ++i) voxel_rgb[piece[i]] = (*colors)[i];
+    }
+    add_stats(stats, ps);
+  }
+  for (const LevelStats& ls : stats.levels) {
+    stats.voxels += ls.voxels;
+    stats.corrections += ls.corrections;
+  }
+  std::vector<std::array<float, 3>> out;
+  if (!options.dependencies_only) {
+    out.resize(target.sample.size());
+    for (size_t i = 0; i < target.sample.size(); ++i) out[i] = voxel_rgb[target.sample[i]];
+  }
+  interrupter.end();
+  stats.seconds = since(t_start);
+  if (stats_out) *stats_out = std::move(stats);
   return out;
 }
 

@@ -56,7 +56,13 @@ struct SynthesisOptions {
   // Compute the dependency sets and their sizes only (stats), synthesize nothing; the
   // returned colors are then empty. For measuring schemes at sizes too big to synthesize.
   bool dependencies_only = false;
+  // Working-memory limit of one request (bytes; 0 = none). A request whose cost estimate
+  // (cost_model.h) or whose computed sets need more is refused with kUnprocessable before
+  // anything that size is allocated.
+  int64_t max_bytes = 0;
 };
+
+struct RequestCost;
 
 class Synthesizer {
  public:
@@ -70,6 +76,10 @@ class Synthesizer {
                                                        SynthesisStats* stats = nullptr,
                                                        const SynthesisOptions& options = {});
 
+  // Upper bounds of what synthesize(target) allocates, per level (cost_model.h). Scattered
+  // targets are split into compact pieces first; this is the cost of the largest piece.
+  RequestCost estimate(const TargetSet& target) const;
+
   const Table& table() const { return *table_; }
   const FrameField& field() const { return *field_; }
   const SynthesisParams& params() const { return params_; }
@@ -78,6 +88,9 @@ class Synthesizer {
 
  private:
   Synthesizer() = default;
+  // One compact piece of a request: colors per target voxel (target.voxels order).
+  Result<std::vector<std::array<float, 3>>> synthesize_piece(const TargetSet& piece, LatchedInterrupter& poller,
+                                                             SynthesisStats& stats, const SynthesisOptions& options);
   struct Impl;
   std::shared_ptr<const Table> table_;
   std::shared_ptr<const FrameField> field_;

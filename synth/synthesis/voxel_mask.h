@@ -28,6 +28,7 @@ class VoxelMask {
   bool insert(const Voxel& p);
   bool contains(const Voxel& p) const;
   int64_t count() const { return count_.load(std::memory_order_relaxed); }
+  int64_t bricks() const { return bricks_; }  // allocated bricks (not thread-safe with inserts)
   std::vector<Voxel> to_vector() const;
 
  private:
