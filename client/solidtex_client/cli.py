@@ -19,7 +19,7 @@ import argparse
 import json
 import os
 import sys
-from typing import Any, List, Optional, Sequence
+from typing import Any, Callable, List, Optional, Sequence
 
 import numpy as np
 import requests
@@ -28,28 +28,25 @@ from .client import Client
 from .errors import SolidtexError
 
 
-def _ints(n: int):
-    def parse(text: str) -> List[int]:
+def _numbers(n: int, convert: Callable[[str], Any], noun: str):
+    """An argparse type: exactly ``n`` comma-separated values, each read by ``convert``."""
+    def parse(text: str) -> List[Any]:
         try:
-            values = [int(s) for s in text.split(",")]
+            values = [convert(s) for s in text.split(",")]
         except ValueError:
-            raise argparse.ArgumentTypeError(f"expected {n} comma-separated integers, got {text!r}")
-        if len(values) != n:
-            raise argparse.ArgumentTypeError(f"expected {n} comma-separated integers, got {text!r}")
+            values = None
+        if values is None or len(values) != n:
+            raise argparse.ArgumentTypeError(f"expected {n} comma-separated {noun}, got {text!r}")
         return values
     return parse
+
+
+def _ints(n: int):
+    return _numbers(n, int, "integers")
 
 
 def _floats(n: int):
-    def parse(text: str) -> List[float]:
-        try:
-            values = [float(s) for s in text.split(",")]
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"expected {n} comma-separated numbers, got {text!r}")
-        if len(values) != n:
-            raise argparse.ArgumentTypeError(f"expected {n} comma-separated numbers, got {text!r}")
-        return values
-    return parse
+    return _numbers(n, float, "numbers")
 
 
 def _print_json(value: Any) -> None:

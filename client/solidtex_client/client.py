@@ -34,6 +34,7 @@ _REGION_ACCEPT = {
     "uint8": "application/octet-stream",
     "float32": "application/octet-stream; dtype=float32",
 }
+_SURFACE_ACCEPT = {"ply": "application/x-ply", "json": "application/json"}
 
 
 # ----------------------------------------------------------------------------------------
@@ -151,6 +152,18 @@ def _query_value(v: Any) -> str:
     return _num(v)
 
 
+def _rows(values: Any, width: int, dtype: Any = np.float64) -> np.ndarray:
+    """``values`` (nested sequences or an array) as an (N, ``width``) array of ``dtype``."""
+    return np.asarray(values, dtype=np.float64).reshape(-1, width).astype(dtype, copy=False)
+
+
+def _accept(formats: Mapping[str, str], fmt: str, what: str) -> str:
+    """The Accept header for answer format ``fmt``; ``ValueError`` for a format not offered."""
+    if fmt not in formats:
+        raise ValueError(f"{what} must be one of {sorted(formats)}")
+    return formats[fmt]
+
+
 def _shape(response: requests.Response, fallback: Optional[Sequence[int]] = None) -> Tuple[int, ...]:
     header = response.headers.get("X-Shape")
     if header:
@@ -160,17 +173,28 @@ def _shape(response: requests.Response, fallback: Optional[Sequence[int]] = None
     return tuple(fallback)
 
 
-def _raw_array(response: requests.Response, dtype: str,
-               fallback: Optional[Sequence[int]] = None) -> np.ndarray:
+def _binary_answer(response: requests.Response, fmt: str,
+                   fallback: Optional[Sequence[int]] = None) -> Any:
+    """A slice, cut, region or points answer decoded for ``fmt``: ``png_bytes`` and ``vdb``
+    -> the bytes as sent; ``png`` -> a ``PIL.Image``; ``uint8`` (sRGB) and ``float32``
+    (linear, little-endian on the wire) -> a numpy array shaped by the ``X-Shape`` header, or
+    by ``fallback`` when the answer has none."""
+    if fmt in ("png_bytes", "vdb"):
+        return response.content
+    if fmt == "png":
+        from PIL import Image
+        img = Image.open(io.BytesIO(response.content))
+        img.load()
+        return img
     shape = _shape(response, fallback)
-    np_dtype = np.dtype("<f4") if dtype == "float32" else np.dtype(np.uint8)
+    np_dtype = np.dtype("<f4") if fmt == "float32" else np.dtype(np.uint8)
     data = response.content
     expected = int(np.prod(shape)) * np_dtype.itemsize
     if len(data) != expected:
         raise ValueError(f"raw answer has {len(data)} bytes, X-Shape {shape} of {np_dtype} "
                          f"needs {expected}")
     arr = np.frombuffer(data, dtype=np_dtype).reshape(shape)
-    return arr.astype(np.float32) if dtype == "float32" else arr.copy()
+    return arr.astype(np.float32) if fmt == "float32" else arr.copy()
 
 
 class Client:
@@ -224,9 +248,13 @@ class Client:
             raise error_from_response(response)
         return response
 
-    def _http_timeout(self, deadline: Optional[float]) -> float:
-        # Leave the server time to answer 504 itself before the socket gives up.
-        return max(self.timeout, (deadline or 0) + 10)
+    def _timed(self, method: str, path: str, timeout: Optional[float], *,
+               params: Optional[Mapping[str, Any]] = None, **kwargs: Any) -> requests.Response:
+        """A request with the server-side deadline ``timeout`` (seconds; ``None``: the
+        server's default) in its query. The HTTP timeout leaves the server time to answer
+        504 itself before the socket gives up."""
+        return self.request(method, path, params={**(params or {}), "timeout": timeout},
+                            http_timeout=max(self.timeout, (timeout or 0) + 10), **kwargs)
 
     # -- service --------------------------------------------------------------------------
 
@@ -326,8 +354,7 @@ class Client:
 
         ``timeout`` is the server-side deadline in seconds.
         """
-        return self.request("POST", "/v1/fields", json=dict(sketch), params={"timeout": timeout},
-                            http_timeout=self._http_timeout(timeout)).json()
+        return self._timed("POST", "/v1/fields", timeout, json=dict(sketch)).json()
 
     def get_field(self, field_id: str) -> Dict[str, Any]:
         """GET /v1/fields/{id}."""
@@ -344,9 +371,8 @@ class Client:
     def add_curve(self, field_id: str, curve: Mapping[str, Any],
                   timeout: Optional[float] = None) -> Dict[str, Any]:
         """POST /v1/fields/{id}/curves: add one sketch curve and re-solve (revision + 1)."""
-        return self.request("POST", f"/v1/fields/{field_id}/curves", json=dict(curve),
-                            params={"timeout": timeout},
-                            http_timeout=self._http_timeout(timeout)).json()
+        return self._timed("POST", f"/v1/fields/{field_id}/curves", timeout,
+                           json=dict(curve)).json()
 
     def sample_frames(self, field_id: str, min: Sequence[float], size: Sequence[int],
                       step: float = 1.0) -> Dict[str, Any]:
@@ -360,7 +386,7 @@ class Client:
                            params={"min": list(min), "size": list(size), "step": step}).json()
         for key, width in (("points", 3), ("quaternions", 4), ("scales", 3)):
             if key in out:
-                out[key] = np.asarray(out[key], dtype=np.float64).reshape(-1, width)
+                out[key] = _rows(out[key], width)
         return out
 
     def field_from_mesh(self, mesh_id: str, kind: str, *,
@@ -388,11 +414,8 @@ class Client:
             if value is not None:
                 body[key] = value
         if curves is not None:
-            body["curves"] = [np.asarray(c, dtype=np.float64).reshape(-1, 3).tolist()
-                              for c in curves]
-        return self.request("POST", "/v1/fields/from-mesh", json=body,
-                            params={"timeout": timeout},
-                            http_timeout=self._http_timeout(timeout)).json()
+            body["curves"] = [_rows(c, 3).tolist() for c in curves]
+        return self._timed("POST", "/v1/fields/from-mesh", timeout, json=body).json()
 
     # -- meshes ---------------------------------------------------------------------------
 
@@ -442,21 +465,17 @@ class Client:
         the extra mesh-coordinate ``points``, stored meshes only) as linear float32 (N, 3)
         arrays, ``placement`` and ``stats``. ``timeout`` is the server-side deadline, seconds.
         """
-        if fmt not in ("ply", "json"):
-            raise ValueError("fmt must be 'ply' or 'json'")
+        accept = _accept(_SURFACE_ACCEPT, fmt, "fmt")
         if (mesh_id is None) == (mesh is None):
             raise ValueError("give exactly one of mesh_id and mesh")
-        accept = "application/x-ply" if fmt == "ply" else "application/json"
-        http_timeout = self._http_timeout(timeout)
         path = f"/v1/volumes/{volume_id}/surface"
         if mesh_id is not None:
             body: Dict[str, Any] = {"mesh": mesh_id, "format": fmt}
             if placement is not None:
                 body["placement"] = dict(placement)
             if points is not None:
-                body["points"] = np.asarray(points, dtype=np.float64).reshape(-1, 3).tolist()
-            r = self.request("POST", path, json=body, params={"timeout": timeout},
-                             headers={"Accept": accept}, http_timeout=http_timeout)
+                body["points"] = _rows(points, 3).tolist()
+            r = self._timed("POST", path, timeout, json=body, headers={"Accept": accept})
         else:
             if points is not None:
                 raise ValueError("points need a stored mesh (mesh_id)")
@@ -466,10 +485,10 @@ class Client:
                 raise ValueError(f"a sent mesh takes only resolution and margin as placement, "
                                  f"not {sorted(unknown)}; upload it to use scale/translate")
             params = {"resolution": pl.get("resolution"), "margin": pl.get("margin"),
-                      "format": fmt, "timeout": timeout}
-            r = self.request("POST", path, params=params, data=mesh_bytes(mesh),
-                             headers={"Content-Type": "application/octet-stream",
-                                      "Accept": accept}, http_timeout=http_timeout)
+                      "format": fmt}
+            r = self._timed("POST", path, timeout, params=params, data=mesh_bytes(mesh),
+                            headers={"Content-Type": "application/octet-stream",
+                                     "Accept": accept})
         if fmt == "ply":
             out = parse_colored_ply(r.content)
             out.headers = {k: v for k, v in r.headers.items() if k.lower().startswith("x-")}
@@ -477,7 +496,7 @@ class Client:
         answer = r.json()
         for key in ("colors", "point_colors"):
             if key in answer:
-                answer[key] = np.asarray(answer[key], dtype=np.float64).reshape(-1, 3).astype(np.float32)
+                answer[key] = _rows(answer[key], 3, np.float32)
         return answer
 
     # -- volumes --------------------------------------------------------------------------
@@ -535,16 +554,6 @@ class Client:
         """GET /v1/volumes/{id}/stats: voxels per level, cache bytes and hits, recent requests."""
         return self.request("GET", f"/v1/volumes/{volume_id}/stats").json()
 
-    def _cut_answer(self, response: requests.Response, dtype: str) -> Any:
-        if dtype == "png_bytes":
-            return response.content
-        if dtype == "png":
-            from PIL import Image
-            img = Image.open(io.BytesIO(response.content))
-            img.load()
-            return img
-        return _raw_array(response, dtype)
-
     def slice(self, volume_id: str, axis: str, at: int, size: Sequence[int],
               origin: Sequence[int] = (0, 0), dtype: str = "uint8",
               timeout: Optional[float] = None) -> Any:
@@ -556,14 +565,11 @@ class Client:
         ``PIL.Image``; ``"png_bytes"`` -> the PNG bytes as sent. ``timeout`` is the
         server-side deadline in seconds (504 past it).
         """
-        if dtype not in _CUT_ACCEPT:
-            raise ValueError(f"dtype must be one of {sorted(_CUT_ACCEPT)}")
-        params = {"axis": axis, "at": int(at), "origin": list(origin), "size": list(size),
-                  "timeout": timeout}
-        r = self.request("GET", f"/v1/volumes/{volume_id}/slice", params=params,
-                         headers={"Accept": _CUT_ACCEPT[dtype]},
-                         http_timeout=self._http_timeout(timeout))
-        return self._cut_answer(r, dtype)
+        accept = _accept(_CUT_ACCEPT, dtype, "dtype")
+        params = {"axis": axis, "at": int(at), "origin": list(origin), "size": list(size)}
+        r = self._timed("GET", f"/v1/volumes/{volume_id}/slice", timeout, params=params,
+                        headers={"Accept": accept})
+        return _binary_answer(r, dtype)
 
     def cut(self, volume_id: str, origin: Sequence[float], u: Sequence[float],
             v: Sequence[float], size: Sequence[int], dtype: str = "uint8",
@@ -573,14 +579,12 @@ class Client:
 
         ``dtype`` and ``timeout`` as for :meth:`slice`.
         """
-        if dtype not in _CUT_ACCEPT:
-            raise ValueError(f"dtype must be one of {sorted(_CUT_ACCEPT)}")
+        accept = _accept(_CUT_ACCEPT, dtype, "dtype")
         body = {"origin": [float(x) for x in origin], "u": [float(x) for x in u],
                 "v": [float(x) for x in v], "size": [int(x) for x in size]}
-        r = self.request("POST", f"/v1/volumes/{volume_id}/cut", json=body,
-                         params={"timeout": timeout}, headers={"Accept": _CUT_ACCEPT[dtype]},
-                         http_timeout=self._http_timeout(timeout))
-        return self._cut_answer(r, dtype)
+        r = self._timed("POST", f"/v1/volumes/{volume_id}/cut", timeout, json=body,
+                        headers={"Accept": accept})
+        return _binary_answer(r, dtype)
 
     def region(self, volume_id: str, min: Sequence[int], size: Sequence[int],
                fmt: str = "vdb", timeout: Optional[float] = None) -> Any:
@@ -591,26 +595,19 @@ class Client:
         ``"uint8"`` -> sRGB uint8 array (D, H, W, 3); ``"float32"`` -> linear float32 array
         (D, H, W, 3). Index ``[z, y, x]`` is voxel ``min + (x, y, z)``.
         """
-        if fmt not in _REGION_ACCEPT:
-            raise ValueError(f"fmt must be one of {sorted(_REGION_ACCEPT)}")
-        r = self.request("GET", f"/v1/volumes/{volume_id}/region",
-                         params={"min": list(min), "size": list(size), "timeout": timeout},
-                         headers={"Accept": _REGION_ACCEPT[fmt]},
-                         http_timeout=self._http_timeout(timeout))
-        if fmt == "vdb":
-            return r.content
+        accept = _accept(_REGION_ACCEPT, fmt, "fmt")
+        r = self._timed("GET", f"/v1/volumes/{volume_id}/region", timeout,
+                        params={"min": list(min), "size": list(size)}, headers={"Accept": accept})
         w, h, d = (int(s) for s in size)
-        return _raw_array(r, fmt, fallback=(d, h, w, 3))
+        return _binary_answer(r, fmt, fallback=(d, h, w, 3))
 
     def points(self, volume_id: str, xyz: Any, timeout: Optional[float] = None) -> np.ndarray:
         """POST /v1/volumes/{id}/points: linear RGB float32 (N, 3) at world points ``xyz``
         (N, 3), each rounded to its nearest finest voxel (voxel (i, j, k) is at (i, j, k)).
         """
-        pts = np.asarray(xyz, dtype=np.float64).reshape(-1, 3)
-        body = pts.astype("<f4").tobytes()
-        r = self.request("POST", f"/v1/volumes/{volume_id}/points", data=body,
-                         params={"timeout": timeout},
-                         headers={"Content-Type": "application/octet-stream",
-                                  "Accept": "application/octet-stream"},
-                         http_timeout=self._http_timeout(timeout))
-        return _raw_array(r, "float32", fallback=(len(pts), 3))
+        pts = _rows(xyz, 3)
+        r = self._timed("POST", f"/v1/volumes/{volume_id}/points", timeout,
+                        data=pts.astype("<f4").tobytes(),
+                        headers={"Content-Type": "application/octet-stream",
+                                 "Accept": "application/octet-stream"})
+        return _binary_answer(r, "float32", fallback=(len(pts), 3))

@@ -7,14 +7,13 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
-from types import SimpleNamespace
 
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import support  # noqa: E402
-from support import ANALYSIS_CLI, ServerFactory, run_cli, solidtex_bin, upload_ready  # noqa: E402
+from support import ANALYSIS_CLI, ServerFactory, run_cli, server_with_volume, solidtex_bin  # noqa: E402
 
 KINDS = ("wood", "stripes", "bricks", "noise", "spots")
 
@@ -68,20 +67,11 @@ def cli_table(binary, exemplars, tmp_path_factory) -> Path:
 def shared(binary, exemplars, tmp_path_factory):
     """One server for the read-mostly tests: wood analysed (ready) and a volume with seed 7.
 
-    Namespace: server, client, exemplar (dict), exemplar_id, volume_id, table (bytes),
-    table_path (the downloaded .stx), dir (scratch directory)."""
-    base = tmp_path_factory.mktemp("shared")
-    factory = ServerFactory(base / "servers")
-    try:
-        srv = factory.start()
-        client = srv.client
-        ex = upload_ready(client, exemplars["wood"], name="wood")
-        table = client.get_exemplar_table(ex["id"])
-        table_path = base / "server.stx"
-        table_path.write_bytes(table)
-        vol = client.create_volume({"exemplar": ex["id"], "seed": 7})
-        yield SimpleNamespace(server=srv, client=client, exemplar=ex, exemplar_id=ex["id"],
-                              volume_id=vol["id"], volume=vol, table=table,
-                              table_path=table_path, dir=base)
-    finally:
-        factory.close()
+    Namespace: server, url, client, exemplar (dict), exemplar_id, volume (dict), volume_id,
+    table (bytes), table_path (the downloaded .stx), dir (scratch directory)."""
+    with server_with_volume(tmp_path_factory.mktemp("shared"), exemplars["wood"], seed=7,
+                            name="wood") as ns:
+        ns.table = ns.client.get_exemplar_table(ns.exemplar_id)
+        ns.table_path = ns.dir / "server.stx"
+        ns.table_path.write_bytes(ns.table)
+        yield ns

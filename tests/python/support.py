@@ -1,6 +1,7 @@
 """Helpers for the end-to-end tests: starting `solidtex serve`, running the CLI, small checks."""
 from __future__ import annotations
 
+import contextlib
 import io
 import json
 import os
@@ -13,9 +14,11 @@ import sys
 import time
 import zlib
 from pathlib import Path
-from typing import Any, Dict, Iterable, List, Optional, Sequence
+from types import SimpleNamespace
+from typing import Any, Collection, Dict, Iterable, Iterator, List, Optional, Sequence, Union
 
 import numpy as np
+import pytest
 import requests
 
 REPO = Path(__file__).resolve().parents[2]
@@ -29,6 +32,11 @@ from solidtex_client import Client  # noqa: E402
 ANALYSIS = {"levels": 3, "neighborhood": 5, "candidates": 4, "pca_dims": 8}
 ANALYSIS_CLI = ["--levels", "3", "--neighborhood", "5", "--candidates", "4", "--pca-dims", "8"]
 HTTP_TIMEOUT = 120
+# Accept headers of the raw answers: sRGB uint8, linear float32.
+RAW = {"Accept": "application/octet-stream"}
+RAW_F32 = {"Accept": "application/octet-stream; dtype=float32"}
+# Real meshes shared with the other tools: <repo>/../shared/data/meshes or $SOLIDTEX_MESHES.
+MESH_DIR = Path(os.environ.get("SOLIDTEX_MESHES", str(REPO.parent / "shared" / "data" / "meshes")))
 
 
 def solidtex_bin() -> Path:
@@ -154,6 +162,26 @@ class ServerFactory:
             s.stop()
 
 
+@contextlib.contextmanager
+def server_with_volume(base_dir: Path, image: Any, *flags: Any, seed: int,
+                       name: Optional[str] = None) -> Iterator[SimpleNamespace]:
+    """A server started with ``flags`` below ``base_dir``, ``image`` uploaded (as ``name``)
+    and analysed, and a volume of it with ``seed``; the server stops when the block ends.
+
+    Yields a namespace: server, url, client, exemplar (dict), exemplar_id, volume (dict),
+    volume_id, dir (``base_dir``)."""
+    factory = ServerFactory(Path(base_dir) / "servers")
+    try:
+        srv = factory.start(*flags)
+        ex = upload_ready(srv.client, image, name=name)
+        vol = srv.client.create_volume(exemplar=ex["id"], seed=seed)
+        yield SimpleNamespace(server=srv, url=srv.url, client=srv.client, exemplar=ex,
+                              exemplar_id=ex["id"], volume=vol, volume_id=vol["id"],
+                              dir=Path(base_dir))
+    finally:
+        factory.close()
+
+
 def upload_ready(client: Client, image: Any, **params: Any) -> Dict[str, Any]:
     """Upload with the small analysis parameters, wait for the job; returns the exemplar."""
     up = client.upload_exemplar(image, **{**ANALYSIS, **params})
@@ -172,11 +200,68 @@ def file_pixels(path: Path) -> np.ndarray:
     return png_pixels(Path(path).read_bytes())
 
 
-def assert_error(response: requests.Response, status: int, code: Optional[str] = None,
+def srgb8(linear: Any) -> np.ndarray:
+    """The sRGB8 encoding (as float64 integers) of linear colors, as the service encodes them."""
+    c = np.clip(np.asarray(linear, np.float64), 0, 1)
+    s = np.where(c <= 0.0031308, 12.92 * c, 1.055 * np.power(c, 1 / 2.4) - 0.055)
+    return np.rint(s * 255)
+
+
+def shared_mesh(name: str) -> Path:
+    """The path of a shared mesh file; skips the test (with a message) when it is absent."""
+    path = MESH_DIR / name
+    if not path.is_file():
+        pytest.skip(f"shared mesh {path} not found (set SOLIDTEX_MESHES or add ../shared/data)")
+    return path
+
+
+def client_cli(url: str, *args: Any, check: bool = True) -> subprocess.CompletedProcess:
+    """Run ``python -m solidtex_client.cli --url URL ARGS``; with ``check`` a non-zero exit
+    fails the test with the command's output."""
+    env = {**os.environ, "PYTHONPATH": str(CLIENT_DIR) + os.pathsep + os.environ.get("PYTHONPATH", "")}
+    cmd = [sys.executable, "-m", "solidtex_client.cli", "--url", url, *[str(a) for a in args]]
+    proc = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=300)
+    if check:
+        assert proc.returncode == 0, (f"{' '.join(cmd)}: exit {proc.returncode}\n"
+                                      f"{proc.stdout}\n{proc.stderr}")
+    return proc
+
+
+def fake_response(status: int, body: Any = b"", headers: Optional[Dict[str, str]] = None
+                  ) -> requests.Response:
+    """A ``requests.Response`` with ``status``, ``body`` (bytes, or JSON for anything else)
+    and ``headers``, for the client tests without a server."""
+    r = requests.Response()
+    r.status_code = status
+    r._content = body if isinstance(body, bytes) else json.dumps(body).encode()
+    r.headers.update(headers or {})
+    r.encoding = "utf-8"
+    return r
+
+
+class FakeSession(requests.Session):
+    """Records the prepared requests (``sent``) and answers from a list of canned responses."""
+
+    def __init__(self, answers: Iterable[requests.Response]) -> None:
+        super().__init__()
+        self.answers = list(answers)
+        self.sent: List[requests.PreparedRequest] = []
+
+    def send(self, request, **kwargs):
+        self.sent.append(request)
+        r = self.answers.pop(0)
+        r.request = request
+        return r
+
+
+def assert_error(response: requests.Response, status: Union[int, Collection[int]],
+                 code: Optional[str] = None,
                  field_contains: Optional[str] = None) -> Dict[str, Any]:
-    """The answer has ``status`` and the documented error body; returns the error object."""
-    assert response.status_code == status, (
-        f"expected {status}, got {response.status_code}: {response.text[:500]}")
+    """The answer has ``status`` (or one of the statuses) and the documented error body;
+    returns the error object."""
+    statuses = {status} if isinstance(status, int) else set(status)
+    assert response.status_code in statuses, (
+        f"expected {sorted(statuses)}, got {response.status_code}: {response.text[:500]}")
     assert response.headers.get("Content-Type", "").startswith("application/json"), \
         response.headers.get("Content-Type")
     body = response.json()
@@ -201,6 +286,13 @@ def png_with_header(width: int, height: int) -> bytes:
     ihdr = struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)
     return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr)
             + chunk(b"IDAT", zlib.compress(b"\x00" * 64)) + chunk(b"IEND", b""))
+
+
+def post_bytes(url: str, body: bytes, params: Optional[Dict[str, Any]] = None,
+               timeout: float = 60) -> requests.Response:
+    """POST ``body`` as ``application/octet-stream`` (an image, mesh or points upload)."""
+    return requests.post(url, params=params, data=body,
+                         headers={"Content-Type": "application/octet-stream"}, timeout=timeout)
 
 
 def raw_post(url: str, path: str, body: bytes, content_type: str = "application/octet-stream",

@@ -1,24 +1,10 @@
 """The Python client's command line against a running server."""
 import json
-import os
-import subprocess
-import sys
 
 import numpy as np
 from PIL import Image
 
-from support import CLIENT_DIR, file_pixels
-
-
-def client_cli(url, *args, check=True):
-    env = dict(os.environ)
-    env["PYTHONPATH"] = str(CLIENT_DIR) + os.pathsep + env.get("PYTHONPATH", "")
-    proc = subprocess.run([sys.executable, "-m", "solidtex_client.cli", "--url", url,
-                           *[str(a) for a in args]], capture_output=True, text=True, env=env,
-                          timeout=300)
-    if check:
-        assert proc.returncode == 0, f"exit {proc.returncode}\n{proc.stdout}\n{proc.stderr}"
-    return proc
+from support import client_cli, file_pixels
 
 
 def test_cli_slice_writes_png(shared, tmp_path):

@@ -7,14 +7,14 @@ from urllib.parse import parse_qs, urlsplit
 
 import numpy as np
 import pytest
-import requests
 from PIL import Image
 
-import support  # noqa: F401  (puts <repo>/client on sys.path)
+from support import FakeSession, fake_response  # (support also puts <repo>/client on sys.path)
 from solidtex_client import (BadRequest, Client, Conflict, DeadlineExceeded, JobFailed,
                              MethodNotAllowed, NotFound, PayloadTooLarge, ServiceUnavailable,
                              SolidtexError, TooManyRequests, Unprocessable, UnsupportedMediaType,
                              encode_png, error_from_response)
+from solidtex_client import cli as cli_module
 from solidtex_client.cli import main as cli_main
 
 
@@ -60,15 +60,6 @@ def test_encode_png_float_is_16_bit():
         encode_png(np.zeros((2, 2, 5), dtype=np.uint8))
 
 
-def fake_response(status, body=b"", headers=None):
-    r = requests.Response()
-    r.status_code = status
-    r._content = body if isinstance(body, bytes) else json.dumps(body).encode()
-    r.headers.update(headers or {})
-    r.encoding = "utf-8"
-    return r
-
-
 @pytest.mark.parametrize("status,cls", [
     (400, BadRequest), (404, NotFound), (405, MethodNotAllowed), (409, Conflict),
     (413, PayloadTooLarge), (415, UnsupportedMediaType), (422, Unprocessable),
@@ -94,21 +85,6 @@ def test_error_details():
     j = JobFailed({"id": "j1", "state": "failed",
                    "error": {"code": "corrupt", "message": "bad png", "field": "body"}})
     assert j.status is None and j.code == "corrupt" and j.field == "body"
-
-
-class FakeSession(requests.Session):
-    """Records prepared requests and answers from a list of canned responses."""
-
-    def __init__(self, answers):
-        super().__init__()
-        self.answers = list(answers)
-        self.sent = []
-
-    def send(self, request, **kwargs):
-        self.sent.append(request)
-        r = self.answers.pop(0)
-        r.request = request
-        return r
 
 
 def test_upload_raw_and_multipart():
@@ -195,3 +171,52 @@ def test_cli_reports_errors(capsys, tmp_path):
     assert cli_main(["--url", "http://127.0.0.1:9", "slice", "v", "--axis", "z", "--at", "0",
                      "--size", "4,4", "-o", str(tmp_path / "x.png")]) == 1
     assert capsys.readouterr().err.startswith("error: connection: ")
+
+
+def test_region_answers_and_format_checks():
+    box = np.arange(2 * 3 * 4 * 3, dtype=np.uint8)
+    s = FakeSession([fake_response(200, box.tobytes()),                  # no X-Shape: from size
+                     fake_response(200, bytes(10), {"X-Shape": "2,3,4,3"}),
+                     fake_response(200, b" BDV..."),
+                     fake_response(200, np.zeros((2, 3), "<f4").tobytes())])
+    c = Client("http://svc:1", session=s)
+    a = c.region("v", (1, 2, 3), (4, 3, 2), fmt="uint8", timeout=7)
+    assert a.shape == (2, 3, 4, 3) and np.array_equal(a.ravel(), box)
+    assert s.sent[0].headers["Accept"] == "application/octet-stream"
+    assert parse_qs(urlsplit(s.sent[0].url).query) == {"min": ["1,2,3"], "size": ["4,3,2"],
+                                                       "timeout": ["7"]}
+    with pytest.raises(ValueError, match="10 bytes"):
+        c.region("v", (0, 0, 0), (4, 3, 2), fmt="uint8")
+    assert c.region("v", (0, 0, 0), (1, 1, 1)) == b" BDV..."
+    assert s.sent[2].headers["Accept"] == "application/x-vdb"
+    pts = c.points("v", np.array([[0, 0, 0], [1, 1, 1]]))                   # no X-Shape: N x 3
+    assert pts.shape == (2, 3) and pts.dtype == np.float32
+    for call in (lambda: c.region("v", (0, 0, 0), (1, 1, 1), fmt="png"),
+                 lambda: c.slice("v", "z", 0, (1, 1), dtype="vdb"),
+                 lambda: c.cut("v", (0, 0, 0), (1, 0, 0), (0, 1, 0), (1, 1), dtype="f16")):
+        with pytest.raises(ValueError, match="must be one of"):
+            call()
+    assert len(s.sent) == 4, "a bad format was sent"
+
+
+def test_cli_volume_scheme_and_number_lists(capsys, monkeypatch):
+    session = FakeSession([fake_response(201, {"id": "v1"})])
+    monkeypatch.setattr(cli_module, "Client",
+                        lambda url, timeout: Client(url, timeout=timeout, session=session))
+    assert cli_main(["--url", "http://svc:1", "volume", "--exemplar", "e", "--scheme", "plain",
+                     "--seed", "3"]) == 0
+    assert json.loads(capsys.readouterr().out) == {"id": "v1"}
+    assert json.loads(session.sent[0].body) == {"exemplar": "e", "params": {"scheme": "plain"},
+                                               "seed": 3}
+    for argv, needle in ((["volume", "--exemplar", "e", "--scheme", "standard"], "invalid choice"),
+                         (["slice", "v", "--axis", "z", "--at", "0", "--size", "4", "-o", "x"],
+                          "expected 2 comma-separated integers, got '4'"),
+                         (["slice", "v", "--axis", "z", "--at", "0", "--size", "4,x", "-o", "x"],
+                          "expected 2 comma-separated integers, got '4,x'"),
+                         (["upload", "a.png", "--plane-weights", "1,2"],
+                          "expected 3 comma-separated numbers, got '1,2'")):
+        with pytest.raises(SystemExit) as info:
+            cli_main(argv)
+        assert info.value.code == 2
+        assert needle in capsys.readouterr().err, argv
+    assert len(session.sent) == 1

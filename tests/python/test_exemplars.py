@@ -1,16 +1,14 @@
 """Exemplar upload, background analysis, table download and bit identity with the CLI."""
 import numpy as np
-import requests
 
-from support import ANALYSIS, ANALYSIS_CLI, file_pixels, run_cli
+from support import ANALYSIS, ANALYSIS_CLI, file_pixels, post_bytes, run_cli
 from solidtex_client import encode_png
 
 
 def test_upload_analyse_download_matches_cli(shared, exemplars, cli_table):
     c = shared.client
-    r = requests.post(shared.server.url + "/v1/exemplars", params={**ANALYSIS, "name": "wood2"},
-                      data=exemplars["wood"].read_bytes(),
-                      headers={"Content-Type": "application/octet-stream"}, timeout=60)
+    r = post_bytes(shared.server.url + "/v1/exemplars", exemplars["wood"].read_bytes(),
+                   params={**ANALYSIS, "name": "wood2"})
     assert r.status_code == 202, r.text
     assert r.headers.get("Location"), r.headers
     body = r.json()
@@ -25,8 +23,7 @@ def test_upload_analyse_download_matches_cli(shared, exemplars, cli_table):
     assert final["state"] == "succeeded"
     assert final["percent"] == 100
     assert final.get("error") is None
-    if "exemplar_id" in final:
-        assert final["exemplar_id"] == ex["id"]
+    assert final["exemplar_id"] == ex["id"]
 
     got = c.get_exemplar(ex["id"])
     assert got["id"] == ex["id"]
@@ -34,7 +31,8 @@ def test_upload_analyse_download_matches_cli(shared, exemplars, cli_table):
     assert got["name"] == "wood2"
     assert got["planes"] == 1
     assert (got["width"], got["height"]) == (64, 64)
-    assert got.get("has_mask") in (None, False)
+    assert got["has_mask"] is False
+    assert got["job_id"] == job["id"]
     levels = got["levels"]
     assert len(levels) == 3
     for lv in levels:
@@ -44,8 +42,7 @@ def test_upload_analyse_download_matches_cli(shared, exemplars, cli_table):
 
     table = c.get_exemplar_table(ex["id"])
     assert table[:8] == b"STXTABLE"
-    if "table_bytes" in got:
-        assert got["table_bytes"] == len(table)
+    assert got["table_bytes"] == len(table)
     assert table == cli_table.read_bytes(), "service table differs from `solidtex analyze`"
     # the shared fixture's upload of the same image gives the same table too
     assert shared.table == table

@@ -55,8 +55,8 @@ def test_field_lifecycle_and_volume_matches_cli(shared, tmp_path):
     assert pts.shape == (24, 3)
     assert {tuple(p) for p in pts.tolist()} == {(2 + 8 * i, 2 + 8 * j, 2 + 8 * k)
                                                for i in range(4) for j in range(3) for k in range(2)}
-    if "scales" in frames:
-        assert np.allclose(frames["scales"], 1.0)
+    assert frames["scales"].shape == (24, 3)
+    assert np.allclose(frames["scales"], 1.0)
 
     stf = c.get_field_file(fid)
     assert stf[:8] == b"STXFIELD"

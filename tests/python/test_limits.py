@@ -2,28 +2,20 @@
 deadline 504, and the server keeps serving afterwards."""
 import threading
 import time
-from types import SimpleNamespace
 
 import pytest
 import requests
 
-from support import ServerFactory, assert_error, metric_lines, upload_ready
+from support import RAW, assert_error, metric_lines, post_bytes, server_with_volume
 
 pytestmark = pytest.mark.slow
-
-RAW = {"Accept": "application/octet-stream"}
 
 
 @pytest.fixture(scope="module")
 def busy(binary, exemplars, tmp_path_factory):
-    factory = ServerFactory(tmp_path_factory.mktemp("limits"))
-    try:
-        srv = factory.start("--threads", "1", "--queue", "1")
-        ex = upload_ready(srv.client, exemplars["wood"])
-        vol = srv.client.create_volume(exemplar=ex["id"], seed=3)
-        yield SimpleNamespace(server=srv, url=srv.url, client=srv.client, volume_id=vol["id"])
-    finally:
-        factory.close()
+    with server_with_volume(tmp_path_factory.mktemp("limits"), exemplars["wood"],
+                            "--threads", "1", "--queue", "1", seed=3) as ns:
+        yield ns
 
 
 def small_slice_eventually(url: str, volume_id: str, seconds: float = 30) -> requests.Response:
@@ -98,11 +90,9 @@ def test_too_many_analysis_jobs_is_429(server, exemplars):
     srv = server("--max-jobs", "1")
     data = exemplars["noise"].read_bytes()
     params = {"levels": 3, "neighborhood": 7, "candidates": 8, "pca_dims": 12}
-    first = requests.post(srv.url + "/v1/exemplars", params=params, data=data,
-                          headers={"Content-Type": "application/octet-stream"}, timeout=60)
+    first = post_bytes(srv.url + "/v1/exemplars", data, params=params)
     assert first.status_code == 202, first.text
-    second = requests.post(srv.url + "/v1/exemplars", params=params, data=data,
-                           headers={"Content-Type": "application/octet-stream"}, timeout=60)
+    second = post_bytes(srv.url + "/v1/exemplars", data, params=params)
     assert_error(second, 429)
     from solidtex_client import TooManyRequests
     with pytest.raises(TooManyRequests):
@@ -110,8 +100,7 @@ def test_too_many_analysis_jobs_is_429(server, exemplars):
     srv.client.wait_for_job(first.json()["job"]["id"], timeout=120, poll=0.1)
     # the refused uploads left nothing behind, and a new one is accepted now
     assert [e["id"] for e in srv.client.list_exemplars()] == [first.json()["exemplar"]["id"]]
-    third = requests.post(srv.url + "/v1/exemplars", params=params, data=data,
-                          headers={"Content-Type": "application/octet-stream"}, timeout=60)
+    third = post_bytes(srv.url + "/v1/exemplars", data, params=params)
     assert third.status_code == 202, third.text
 
 

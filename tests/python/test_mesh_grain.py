@@ -5,7 +5,7 @@ across the z-axis cylinder) the same measure is clearly worse."""
 import numpy as np
 import requests
 
-from support import ANALYSIS, upload_ready
+from support import ANALYSIS
 
 AROUND, ALONG = 64, 40
 

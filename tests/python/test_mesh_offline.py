@@ -5,10 +5,9 @@ from urllib.parse import parse_qs, urlsplit
 
 import numpy as np
 import pytest
-import requests
 from PIL import Image
 
-import support  # noqa: F401  (puts <repo>/client on sys.path)
+from support import FakeSession, fake_response  # (support also puts <repo>/client on sys.path)
 from solidtex_client import Client, ColoredMesh, PlyFormatError, parse_colored_ply
 from solidtex_client import cli as cli_module
 from solidtex_client.render import camera_basis, render
@@ -218,28 +217,6 @@ def test_render_100k_triangles_fast_and_without_holes():
 
 
 # -- client methods ------------------------------------------------------------------------
-
-
-def fake_response(status, body=b"", headers=None):
-    r = requests.Response()
-    r.status_code = status
-    r._content = body if isinstance(body, bytes) else json.dumps(body).encode()
-    r.headers.update(headers or {})
-    r.encoding = "utf-8"
-    return r
-
-
-class FakeSession(requests.Session):
-    def __init__(self, answers):
-        super().__init__()
-        self.answers = list(answers)
-        self.sent = []
-
-    def send(self, request, **kwargs):
-        self.sent.append(request)
-        r = self.answers.pop(0)
-        r.request = request
-        return r
 
 
 PLY_HEADERS = {"Content-Type": "application/x-ply", "X-Target-Voxels": "3",

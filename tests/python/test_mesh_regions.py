@@ -1,22 +1,14 @@
 """Per-region exemplars by distance to a mesh surface: bark near the surface, wood inside
 (Zhang Fig. 15). Each region is exactly its own texture, so the two sides can be checked
 against single-exemplar volumes bit for bit."""
-from pathlib import Path
-
 import numpy as np
-import pytest
 import requests
 
-from support import upload_ready
-
-MESHES = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "meshes"
-RAW32 = {"Accept": "application/octet-stream; dtype=float32"}
+from support import RAW_F32, shared_mesh, upload_ready
 
 
 def test_surface_shell_takes_the_second_texture_near_the_surface(server, exemplars):
-    bunny = MESHES / "bunny.off"
-    if not bunny.exists():
-        pytest.skip(f"shared meshes absent ({MESHES})")
+    bunny = shared_mesh("bunny.off")
     srv = server()
     c = srv.client
     wood = upload_ready(c, exemplars["wood"])["id"]
@@ -44,7 +36,7 @@ def test_surface_shell_takes_the_second_texture_near_the_surface(server, exempla
     # A z-slice through the middle has both: far from the surface the wood texture, bit for bit.
     def cut(vol):
         r = requests.get(f"{srv.url}/v1/volumes/{vol}/slice",
-                         params={"axis": "z", "at": 24, "size": "48,48", "timeout": 300}, headers=RAW32, timeout=300)
+                         params={"axis": "z", "at": 24, "size": "48,48", "timeout": 300}, headers=RAW_F32, timeout=300)
         assert r.status_code == 200, r.text
         return np.frombuffer(r.content, dtype="<f4").reshape(48, 48, 3)
 
@@ -68,7 +60,7 @@ def test_surface_shell_takes_the_second_texture_near_the_surface(server, exempla
     srv.kill()
     srv2 = server(data_dir=srv.data_dir)
     r = requests.get(f"{srv2.url}/v1/volumes/{shell}/slice",
-                     params={"axis": "z", "at": 24, "size": "48,48", "timeout": 300}, headers=RAW32, timeout=300)
+                     params={"axis": "z", "at": 24, "size": "48,48", "timeout": 300}, headers=RAW_F32, timeout=300)
     assert r.status_code == 200, r.text
     assert np.array_equal(np.frombuffer(r.content, dtype="<f4").reshape(48, 48, 3), s)
 

@@ -67,8 +67,8 @@ def test_kill9_restart_keeps_everything(server, exemplars, tmp_path):
     got = wait_ready(c, pending["exemplar"]["id"])
     assert got["state"] == "ready", got
     assert got["name"] == "pending"
-    job_id = got.get("job_id") or pending["job"]["id"]
-    job = c.wait_for_job(job_id, timeout=60, poll=0.1)
+    assert got["job_id"] == pending["job"]["id"], got
+    job = c.wait_for_job(got["job_id"], timeout=60, poll=0.1)
     assert job["state"] == "succeeded" and job["percent"] == 100
     cli = tmp_path / "spots.stx"
     run_cli("analyze", exemplars["spots"], *ANALYSIS_CLI, "-o", cli)

@@ -4,19 +4,13 @@ Each test reads its own far-apart part of the shared volume so that caching by o
 not hide synthesis in another.
 """
 import numpy as np
+import pytest
 import requests
 
-from support import assert_error, file_pixels, png_pixels, run_cli
+from solidtex_client import BadRequest, Unprocessable
+from support import RAW, assert_error, file_pixels, png_pixels, run_cli, srgb8
 
-RAW = {"Accept": "application/octet-stream"}
-RAW_F32 = {"Accept": "application/octet-stream; dtype=float32"}
 OBLIQUE = dict(origin=(1, 2, 3), u=(0.6, 0.8, 0), v=(-0.48, 0.36, 0.8), size=(32, 24))
-
-
-def srgb8(linear: np.ndarray) -> np.ndarray:
-    x = np.clip(linear.astype(np.float64), 0, 1)
-    s = np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(x, 1 / 2.4) - 0.055)
-    return np.round(s * 255)
 
 
 def test_create_get_delete_volume(shared):
@@ -83,21 +77,37 @@ def test_other_axes(shared):
 
 
 def test_repeated_slice_is_cached(shared):
-    url = f"{shared.server.url}/v1/volumes/{shared.volume_id}/slice"
+    """The answer's X-Voxels-Synthesized is what the volume's stats add up; a repeat is all
+    cache hits (one per target voxel) and synthesizes nothing."""
+    c, vid = shared.client, shared.volume_id
+    url = f"{shared.server.url}/v1/volumes/{vid}/slice"
     params = {"axis": "z", "at": 61, "origin": "400,400", "size": "16,16"}
+
+    def synthesized(stats):
+        return sum(lv["voxels_synthesized"] for lv in stats["levels"])
+
+    before = c.volume_stats(vid)
     r1 = requests.get(url, params=params, headers=RAW, timeout=60)
     assert r1.status_code == 200, r1.text
-    assert int(r1.headers["X-Voxels-Synthesized"]) > 0
+    first = int(r1.headers["X-Voxels-Synthesized"])
+    assert first >= 16 * 16, r1.headers          # at least the target's own voxels
+    mid = c.volume_stats(vid)
+    assert synthesized(mid) - synthesized(before) == first, (before["levels"], mid["levels"])
+    assert mid["recent"][-1]["kind"] == "slice" and mid["recent"][-1]["voxels"] == first, mid
+    assert mid["recent"][-1]["target_voxels"] == 16 * 16, mid["recent"][-1]
+
     r2 = requests.get(url, params=params, headers=RAW, timeout=60)
     assert r2.status_code == 200
     assert r2.content == r1.content
     assert r2.headers["X-Voxels-Synthesized"].strip() == "0"
-    stats = shared.client.volume_stats(shared.volume_id)
-    assert stats["cache"]["hits"] > 0, stats
-    assert stats["cache"]["bytes"] > 0, stats
-    if "volume" in stats:
-        assert stats["volume"] == shared.volume_id
-    assert sum(lv["voxels_synthesized"] for lv in stats["levels"]) > 0, stats
+    after = c.volume_stats(vid)
+    assert after["volume"] == vid
+    assert synthesized(after) == synthesized(mid), (mid["levels"], after["levels"])
+    assert after["cache"]["hits"] - mid["cache"]["hits"] == 16 * 16, (mid["cache"], after["cache"])
+    assert after["cache"]["misses"] == mid["cache"]["misses"], (mid["cache"], after["cache"])
+    assert after["cache"]["bytes"] > 0, after
+    assert after["requests"] == mid["requests"] + 1 == before["requests"] + 2, after
+    assert after["recent"][-1]["voxels"] == 0, after["recent"][-1]
 
 
 def test_cut_matches_cli_plane_and_slice(shared, tmp_path):
@@ -155,3 +165,33 @@ def test_region_default_is_vdb(shared):
     assert r.status_code == 200
     assert r.headers["Content-Type"].startswith("application/x-vdb")
     assert r.content[:4] == b" BDV"
+
+
+def test_old_scheme_name_is_rejected_and_plain_works(shared, tmp_path):
+    """'standard' was renamed 'plain': the old name is refused with a message naming the new
+    one (and creates nothing); 'plain' makes a volume whose slice is the CLI's --scheme plain."""
+    c = shared.client
+    n_before = len(c.list_volumes())
+    r = requests.post(shared.server.url + "/v1/volumes",
+                      json={"exemplar": shared.exemplar_id, "params": {"scheme": "standard"}},
+                      timeout=60)
+    err = assert_error(r, {400, 422}, field_contains="scheme")
+    assert "'plain'" in err["message"], err
+    with pytest.raises((BadRequest, Unprocessable)) as info:
+        c.create_volume(exemplar=shared.exemplar_id, params={"scheme": "standard"})
+    assert "plain" in info.value.message and "scheme" in info.value.field, info.value
+    assert len(c.list_volumes()) == n_before, "a refused volume was stored"
+
+    vol = c.create_volume(exemplar=shared.exemplar_id, seed=7, params={"scheme": "plain"})
+    assert c.last_response.status_code == 201
+    assert vol["params"]["scheme"] == "plain", vol
+    assert c.get_volume(vol["id"])["params"]["scheme"] == "plain"
+    png = c.slice(vol["id"], "z", 3, (32, 24), dtype="png_bytes")
+    out = tmp_path / "plain.png"
+    run_cli("slice", shared.table_path, "--axis", "z", "--at", "3", "--size", "32,24",
+            "--seed", "7", "--scheme", "plain", "-o", out)
+    assert np.array_equal(file_pixels(out), png_pixels(png)), "service plain != CLI --scheme plain"
+    assert shared.volume["params"] == {}, shared.volume     # the default scheme, dual-grid
+    default = c.slice(shared.volume_id, "z", 3, (32, 24))
+    assert not np.array_equal(png_pixels(png), default), "plain and dual-grid gave the same slice"
+    c.delete_volume(vol["id"])
