@@ -1,7 +1,7 @@
 // solidtex serve [--host 127.0.0.1] [--port 8080] [--data DIR] [--threads N] [--io-threads N]
 //   [--queue N] [--deadline S] [--max-deadline S] [--cache-mb M] [--max-upload-mb M]
 //   [--max-image-side PX] [--max-image-pixels N] [--max-voxels N] [--max-field-nodes N]
-//   [--max-jobs N] [--analysis-threads N] [--max-mesh-vertices N] [--max-mesh-faces N]
+//   [--max-jobs N] [--analysis-threads N] [--max-mesh-vertices N] [--max-mesh-faces N] [--max-request-mb M]
 #include "args.h"
 #include "commands.h"
 #include "http_server.h"
@@ -11,7 +11,8 @@ namespace solidtex::cli {
 Status run_serve(const std::vector<std::string>& argv) {
   Args args({"--host", "--port", "--data", "--threads", "--io-threads", "--queue", "--deadline", "--max-deadline",
              "--cache-mb", "--max-upload-mb", "--max-image-side", "--max-image-pixels", "--max-voxels",
-             "--max-field-nodes", "--max-jobs", "--analysis-threads", "--max-mesh-vertices", "--max-mesh-faces"},
+             "--max-field-nodes", "--max-jobs", "--analysis-threads", "--max-mesh-vertices", "--max-mesh-faces",
+             "--max-request-mb"},
             {});
   SOLIDTEX_RETURN_IF_ERROR(args.parse(argv));
   if (!args.positionals().empty())
@@ -35,6 +36,8 @@ Status run_serve(const std::vector<std::string>& argv) {
   c.image_limits.max_pixels = int64_t(pixels);
   SOLIDTEX_ASSIGN_OR_RETURN(double voxels, args.get_double("--max-voxels", double(c.max_voxels), 1, double(int64_t(1) << 24)));
   c.max_voxels = int64_t(voxels);
+  SOLIDTEX_ASSIGN_OR_RETURN(int request_mb, args.get_int("--max-request-mb", int(c.max_request_bytes >> 20), 16, 1 << 20));
+  c.max_request_bytes = int64_t(request_mb) << 20;
   SOLIDTEX_ASSIGN_OR_RETURN(double nodes, args.get_double("--max-field-nodes", double(c.max_field_nodes), 8, double(int64_t(1) << 24)));
   c.max_field_nodes = int64_t(nodes);
   SOLIDTEX_ASSIGN_OR_RETURN(double mesh_vertices, args.get_double("--max-mesh-vertices", double(c.mesh_limits.max_vertices), 3, 1e8));

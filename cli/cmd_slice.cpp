@@ -33,7 +33,8 @@ nlohmann::json stats_json(const SynthesisStats& s) {
           {"seconds", s.seconds},
           {"dependency_seconds", s.dependency_seconds},
           {"corrections_per_second", s.seconds > 0 ? double(s.corrections) / s.seconds : 0.0},
-          {"store_bytes", s.store_bytes}};
+          {"store_bytes", s.store_bytes},
+          {"estimated_bytes", s.estimated_bytes}};
 }
 
 Result<TargetSet> parse_cut(const Args& args) {

@@ -24,6 +24,9 @@ struct ServerConfig {
   int64_t max_upload_bytes = int64_t(64) << 20;   // request body, bytes; beyond: 413
   ImageLimits image_limits;         // side and pixel count, checked from the header: 422
   int64_t max_voxels = int64_t(1) << 22;          // target voxels (output samples) per request: 422
+  // Working memory of one synthesis request (dependency sets and level stores), bytes,
+  // [16 MiB, 1 TiB]; estimated before any work and checked again after dependency analysis: 422.
+  int64_t max_request_bytes = int64_t(1536) << 20;
   int64_t max_field_nodes = int64_t(1) << 18;     // frame-field grid nodes per field: 422 beyond
   MeshLimits mesh_limits;           // vertex and face counts per mesh: 422 beyond
   int max_jobs = 4;                 // analysis jobs queued or running, [1, 1000]; beyond: 429

@@ -41,7 +41,11 @@ struct Volume {
 json stats_json(const std::string& kind, const TargetSet& target, const std::vector<SynthesisStats>& per_region,
                 double seconds) {
   json levels = json::array();
-  int64_t voxels = 0, corrections = 0;
+  int64_t voxels = 0, corrections = 0, store_bytes = 0, estimated_bytes = 0;
+  for (const SynthesisStats& s : per_region) {
+    store_bytes = std::max(store_bytes, s.store_bytes);
+    estimated_bytes = std::max(estimated_bytes, s.estimated_bytes);
+  }
   for (size_t r = 0; r < per_region.size(); ++r)
     for (const LevelStats& l : per_region[r].levels) {
       levels.push_back({{"region", r},
@@ -56,7 +60,8 @@ json stats_json(const std::string& kind, const TargetSet& target, const std::vec
   return {{"kind", kind},         {"target_voxels", int64_t(target.voxels.size())},
           {"samples", int64_t(target.sample.size())},
           {"voxels", voxels},     {"corrections", corrections},
-          {"seconds", seconds},   {"levels", levels}};
+          {"seconds", seconds},   {"levels", levels},
+          {"store_bytes", store_bytes}, {"estimated_bytes", estimated_bytes}};
 }
 
 }  // namespace
@@ -361,11 +366,13 @@ Result<QueryResult> VolumeService::query(const std::string& id, const std::strin
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<SynthesisStats> per_region;
   QueryResult out;
+  SynthesisOptions options;
+  options.max_bytes = impl_->config.max_request_bytes;
   if (v->regions) {
-    SOLIDTEX_ASSIGN_OR_RETURN(out.rgb, v->regions->synthesize(target, interrupter, &per_region));
+    SOLIDTEX_ASSIGN_OR_RETURN(out.rgb, v->regions->synthesize(target, interrupter, &per_region, options));
   } else {
     per_region.resize(1);
-    SOLIDTEX_ASSIGN_OR_RETURN(out.rgb, v->synths[0]->synthesize(target, interrupter, &per_region[0]));
+    SOLIDTEX_ASSIGN_OR_RETURN(out.rgb, v->synths[0]->synthesize(target, interrupter, &per_region[0], options));
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   for (const SynthesisStats& s : per_region) out.voxels_synthesized += s.voxels;

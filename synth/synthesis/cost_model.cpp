@@ -36,21 +36,47 @@ int64_t box_volume(const VoxelBox& b) {
 
 }  // namespace
 
+std::vector<int> measure_spread(const std::vector<LevelSchedule>& schedules, const FrameStencils& stencils) {
+  const int L = stencils.levels();
+  std::vector<int> spread(size_t(L), 0);
+  LatchedInterrupter never(null_interrupter());
+  const DependencyInputs in{&schedules, &stencils, nullptr};
+  // Probes at several phases of the cell and subpass lattices, which bound the spread.
+  for (const int o : {0, 3, 5, 13}) {
+    auto deps = analyze_dependencies(in, TargetSet::from_voxels({{o, o, o}}, 1, 1), never);
+    if (!deps.is_ok()) continue;
+    for (int l = 0; l < L; ++l) {
+      const LevelDependencies& d = (*deps)[size_t(l)];
+      const int V = int(d.needed.size()) - 1;
+      VoxelBox served, all;
+      for (const Voxel& p : d.needed[size_t(V)].to_vector()) served.include(p);
+      for (const Voxel& p : d.needed[0].to_vector()) all.include(p);
+      if (served.empty() || all.empty()) continue;
+      const int grow = std::max({served.lo.x - all.lo.x, served.lo.y - all.lo.y, served.lo.z - all.lo.z,
+                                 all.hi.x - served.hi.x, all.hi.y - served.hi.y, all.hi.z - served.hi.z});
+      spread[size_t(l)] = std::max(spread[size_t(l)], grow);
+    }
+  }
+  return spread;
+}
+
 RequestCost estimate_cost(const std::vector<LevelSchedule>& schedules, const FrameStencils& stencils,
-                          const TargetSet& target) {
+                          const std::vector<int>& spread, const TargetSet& target) {
   RequestCost cost;
   const int L = stencils.levels();
   const std::vector<VoxelBox> boxes = dependency_boxes(schedules, stencils, target.bounds());
   cost.levels.resize(size_t(L));
   int64_t need = int64_t(target.voxels.size());
+  VoxelBox served = target.bounds();
   std::vector<int64_t> store(size_t(L), 0);
   int64_t masks = 0;
   for (int l = L - 1; l >= 0; --l) {
     const LevelSchedule& sch = schedules[size_t(l)];
     const VoxelBox& box = boxes[size_t(l)];
-    const int64_t side = 2 * int64_t(sch.final_version()) * stencils.reach(PyramidLevel{l}) + 1;
-    const int64_t voxels = std::min(box_volume(box), sat_mul(need, sat_mul(side, sat_mul(side, side))));
-    const int64_t bricks = std::min(box_bricks(box), voxels);
+    const VoxelBox set_box = served.dilated(spread[size_t(l)]);
+    const int64_t side = 2 * int64_t(spread[size_t(l)]) + 1;
+    const int64_t voxels = std::min(box_volume(set_box), sat_mul(need, sat_mul(side, sat_mul(side, side))));
+    const int64_t bricks = std::min(box_bricks(set_box), voxels);
     const int64_t versions = sch.final_version() + 1;
     const int64_t mask_bytes = sat_mul(versions, sat_mul(box_bricks(box), kMaskTableBytesPerBrick) +
                                                      sat_mul(bricks, kMaskBrickBytes));
@@ -62,7 +88,10 @@ RequestCost estimate_cost(const std::vector<LevelSchedule>& schedules, const Fra
     lc.bytes = mask_bytes + store[size_t(l)];
     cost.voxels = std::min(cost.voxels + voxels, int64_t(1) << 62);
     masks = std::min(masks + mask_bytes, int64_t(1) << 62);
-    need = voxels;  // parents of a set are at most as many as its voxels
+    // Parents of a set are at most as many as its voxels, and lie in the parents' box.
+    served = {parent_of(set_box.lo), {floor_div(set_box.hi.x - 1, 2) + 1, floor_div(set_box.hi.y - 1, 2) + 1,
+                                      floor_div(set_box.hi.z - 1, 2) + 1}};
+    need = std::min(voxels, box_volume(served));
   }
   int64_t peak_stores = 0;
   for (int l = 0; l < L; ++l) peak_stores = std::max(peak_stores, store[size_t(l)] + (l > 0 ? store[size_t(l - 1)] : 0));
@@ -74,8 +103,14 @@ int64_t store_bytes(const std::vector<LevelSchedule>& schedules, const std::vect
   int64_t peak = 0, previous = 0;
   for (size_t l = 0; l < deps.size(); ++l) {
     const LevelDependencies& d = deps[l];
-    // Cache hits may add bricks the version-0 set does not touch: count them as separate bricks.
-    const int64_t bricks = d.needed[0].bricks() + int64_t(d.cache_hits.size());
+    // Cache hits may add bricks the version-0 set does not touch: count their distinct bricks.
+    const BrickIndex index(d.box);
+    std::vector<size_t> hit_bricks;
+    hit_bricks.reserve(d.cache_hits.size());
+    for (const Voxel& p : d.cache_hits) hit_bricks.push_back(index.brick_of(p));
+    std::sort(hit_bricks.begin(), hit_bricks.end());
+    const int64_t distinct_hits = std::unique(hit_bricks.begin(), hit_bricks.end()) - hit_bricks.begin();
+    const int64_t bricks = d.needed[0].bricks() + distinct_hits;
     const int64_t bytes = sat_mul(box_bricks(d.box), kStoreTableBytesPerBrick) +
                           sat_mul(std::min(bricks, box_bricks(d.box)), 512 * int64_t(schedules[l].slot_count()) * kStateBytes);
     peak = std::max(peak, bytes + previous);

@@ -1,15 +1,17 @@
 // What a synthesis request will cost, known before any work starts, so that a service can
 // refuse it instead of discovering its size by allocating (issue 11).
 //
-// estimate_cost() bounds, per level, the voxels the dependency sets can hold and the bytes
-// dependency analysis and the level store allocate: the sets of level l lie in its box (the
-// final-version box dilated by steps x stencil reach, dependency.h) and within that reach of
-// the voxels the finer level needs, so a level's set holds at most
-//   min(box volume, needed voxels x (2 x steps x reach + 1)^3)
-// voxels; bytes count the brick tables over the box (one per version, dense), the mask bricks
-// and the store bricks (512 voxels x slots x VoxelState each, a brick per voxel at worst).
-// It is an upper bound: cheap (no voxel is touched), and loose for scattered targets, which
-// the synthesizer splits into compact pieces first (split_target()).
+// A level's version-0 set is the voxels it must serve at its final version, dilated by how far
+// the level's correction steps spread dependencies. That spread is far below steps x stencil
+// reach (subpasses update one voxel class per step; grid barriers stop reads at cell borders),
+// so measure_spread() measures it once per synthesizer with the real dependency analysis of
+// a few single-voxel probes. estimate_cost() then bounds, per level,
+//   voxels <= min(volume of the served box dilated by the spread, served voxels x (2 spread + 1)^3)
+// and bytes: the dense brick tables over the level's dependency box (one per version), mask
+// bricks, and store bricks (512 voxels x slots x VoxelState each). It touches no voxel, so a
+// service can refuse a request before allocating; the synthesizer checks the exact store size
+// again after dependency analysis (store_bytes()). Fields whose reach varies in space may
+// spread further than the probes saw: that is what the exact check is for.
 // Thread-safe: pure functions.
 #pragma once
 
@@ -32,8 +34,11 @@ struct RequestCost {
   int64_t bytes = 0;      // the peak: dependency masks of every level, plus two level stores
 };
 
+// Per level (index = level), how many of its own voxels its sets reach beyond what it serves.
+std::vector<int> measure_spread(const std::vector<LevelSchedule>& schedules, const FrameStencils& stencils);
+
 RequestCost estimate_cost(const std::vector<LevelSchedule>& schedules, const FrameStencils& stencils,
-                          const TargetSet& target);
+                          const std::vector<int>& spread, const TargetSet& target);
 
 // Exact bytes of the level stores the forward pass will allocate for computed sets (the peak
 // of two consecutive levels: a level and its parent are alive together).

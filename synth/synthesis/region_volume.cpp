@@ -56,7 +56,8 @@ Result<std::shared_ptr<RegionVolume>> RegionVolume::create(std::vector<std::shar
 }
 
 Result<std::vector<std::array<float, 3>>> RegionVolume::synthesize(const TargetSet& target, Interrupter& interrupter,
-                                                                   std::vector<SynthesisStats>* stats) {
+                                                                   std::vector<SynthesisStats>* stats,
+                                                                   const SynthesisOptions& options) {
   // Split the target's distinct voxels by label, synthesize each part, then map samples back.
   std::vector<std::vector<Voxel>> parts(regions_.size());
   std::vector<std::pair<int, uint32_t>> where(target.voxels.size());
@@ -71,7 +72,7 @@ Result<std::vector<std::array<float, 3>>> RegionVolume::synthesize(const TargetS
   for (size_t k = 0; k < regions_.size(); ++k) {
     if (parts[k].empty()) continue;
     const TargetSet sub = TargetSet::from_voxels(parts[k], int(parts[k].size()), 1);
-    SOLIDTEX_ASSIGN_OR_RETURN(colors[k], regions_[k]->synthesize(sub, interrupter, stats ? &(*stats)[k] : nullptr));
+    SOLIDTEX_ASSIGN_OR_RETURN(colors[k], regions_[k]->synthesize(sub, interrupter, stats ? &(*stats)[k] : nullptr, options));
   }
   std::vector<std::array<float, 3>> out(target.sample.size());
   for (size_t s = 0; s < target.sample.size(); ++s) {

@@ -38,7 +38,8 @@ class RegionVolume {
   // Linear RGB per target sample; `stats` (optional) receives one entry per region.
   Result<std::vector<std::array<float, 3>>> synthesize(const TargetSet& target,
                                                        Interrupter& interrupter = null_interrupter(),
-                                                       std::vector<SynthesisStats>* stats = nullptr);
+                                                       std::vector<SynthesisStats>* stats = nullptr,
+                                                       const SynthesisOptions& options = {});
 
  private:
   std::vector<std::shared_ptr<Synthesizer>> regions_;

@@ -6,6 +6,9 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <map>
+#include <mutex>
+#include <string>
 
 #include "synthesis/correction.h"
 #include "synthesis/cost_model.h"
@@ -19,6 +22,10 @@ namespace solidtex {
 struct Synthesizer::Impl {
   std::vector<CorrectionContext> contexts;  // per level
   FrameStencils stencils;
+  // Per level, measured at the first estimate (cost_model.h); shared between synthesizers
+  // whose schedule, stencils and constant field agree, since it depends on nothing else.
+  std::once_flag spread_once;
+  std::vector<int> spread;
 };
 
 namespace {
@@ -105,6 +112,7 @@ void add_stats(SynthesisStats& into, const SynthesisStats& piece) {
   }
   into.dependency_seconds += piece.dependency_seconds;
   into.store_bytes = std::max(into.store_bytes, piece.store_bytes);
+  into.estimated_bytes = std::max(into.estimated_bytes, piece.estimated_bytes);
   into.unsound_reads += piece.unsound_reads;
   into.unread_required += piece.unread_required;
 }
@@ -258,12 +266,38 @@ Result<std::shared_ptr<Synthesizer>> Synthesizer::create(std::shared_ptr<const T
   return s;
 }
 
+const std::vector<int>& Synthesizer::spread() const {
+  std::call_once(impl_->spread_once, [&] {
+    static std::mutex memo_mutex;
+    static std::map<std::string, std::vector<int>> memo;
+    std::string key;
+    if (impl_->stencils.constant()) {
+      const SynthesisParams& p = params_;
+      key = std::string(scheme_name(p.scheme)) + "/" + std::to_string(p.coarse_passes) + "/" +
+            std::to_string(p.passes) + "/" + std::to_string(p.subpass_size) + "/" + std::to_string(p.cell_size) + "/" +
+            std::to_string(p.trilinear_levels) + "/" + std::to_string(table_->params().neighborhood) + "/" +
+            std::to_string(table_->levels()) + "/" + field_->describe();
+      std::lock_guard<std::mutex> g(memo_mutex);
+      if (auto it = memo.find(key); it != memo.end()) {
+        impl_->spread = it->second;
+        return;
+      }
+    }
+    impl_->spread = measure_spread(schedules_, impl_->stencils);
+    if (!key.empty()) {
+      std::lock_guard<std::mutex> g(memo_mutex);
+      memo.emplace(key, impl_->spread);
+    }
+  });
+  return impl_->spread;
+}
+
 RequestCost Synthesizer::estimate(const TargetSet& target) const {
   const auto pieces = split_target(target, kPieceCell);
-  if (pieces.size() == 1) return estimate_cost(schedules_, impl_->stencils, target);
+  if (pieces.size() == 1) return estimate_cost(schedules_, impl_->stencils, spread(), target);
   RequestCost worst;
   for (const auto& piece : pieces) {
-    RequestCost c = estimate_cost(schedules_, impl_->stencils, piece_target(target, piece));
+    RequestCost c = estimate_cost(schedules_, impl_->stencils, spread(), piece_target(target, piece));
     if (c.bytes > worst.bytes) worst = std::move(c);
   }
   return worst;
@@ -274,7 +308,8 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize_piece(const Ta
                                                                         const SynthesisOptions& options) {
   const int L = table_->levels();
   if (options.max_bytes > 0) {
-    const RequestCost cost = estimate_cost(schedules_, impl_->stencils, target);
+    const RequestCost cost = estimate_cost(schedules_, impl_->stencils, spread(), target);
+    stats.estimated_bytes = cost.bytes;
     if (cost.bytes > options.max_bytes) return too_much_memory(cost.bytes, options.max_bytes);
   }
 

@@ -45,6 +45,7 @@ struct SynthesisStats {
   double seconds = 0;
   double dependency_seconds = 0;
   int64_t store_bytes = 0;        // request-local storage at its peak level
+  int64_t estimated_bytes = 0;    // the cost model's bound for the largest piece, when max_bytes > 0
   // Instrumented mode only: reads outside the computed sets, and set members never read.
   int64_t unsound_reads = 0;
   int64_t unread_required = 0;
@@ -88,6 +89,7 @@ class Synthesizer {
 
  private:
   Synthesizer() = default;
+  const std::vector<int>& spread() const;
   // One compact piece of a request: colors per target voxel (target.voxels order).
   Result<std::vector<std::array<float, 3>>> synthesize_piece(const TargetSet& piece, LatchedInterrupter& poller,
                                                              SynthesisStats& stats, const SynthesisOptions& options);
