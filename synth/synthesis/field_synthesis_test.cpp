@@ -14,6 +14,30 @@
 namespace solidtex {
 namespace {
 
+// A small grain-x table: planes xy = yz = `xy`, zx = `zx`; 3 levels, N = 7.
+std::shared_ptr<const Table> grain_table(const ImageF& xy, const ImageF& zx) {
+  ExemplarInputs in;
+  in.xy = xy;
+  in.yz = xy;
+  in.zx = zx;
+  AnalysisParams ap;
+  ap.levels = 3;
+  ap.neighborhood = 7;
+  ap.candidates = 8;
+  ap.pca_dims = 12;
+  return analyze(ExemplarSet::create(std::move(in)).value(), ap).value().table;
+}
+
+// Synthesis parameters for grain_table(), end grain (yz) down-weighted.
+SynthesisParams grain_params() {
+  SynthesisParams sp;
+  sp.coarse_passes = 2;
+  sp.cell_size = 8;
+  sp.init_subpart = 16;
+  sp.plane_weights = {1.f, 0.1f, 1.f};
+  return sp;
+}
+
 // Concentric circles around z drawn in the z = 0 plane steer a grain-x exemplar so that z-cuts
 // show grain running along the circles.
 TEST(TensorFieldSynthesis, ConcentricCirclesMakeTangentialGrain) {
@@ -33,22 +57,9 @@ TEST(TensorFieldSynthesis, ConcentricCirclesMakeTangentialGrain) {
   ASSERT_TRUE(sketch.is_ok()) << sketch.status().to_string();
   auto field = FieldSolver::solve(*sketch).value()->field().value();
 
-  ExemplarInputs in;
-  in.xy = testing::procedural(ProceduralKind::kStripes, 48, 48);
-  in.yz = in.xy;
-  in.zx = transposed(in.xy);
-  AnalysisParams ap;
-  ap.levels = 3;
-  ap.neighborhood = 7;
-  ap.candidates = 8;
-  ap.pca_dims = 12;
-  auto table = analyze(ExemplarSet::create(std::move(in)).value(), ap).value().table;
-  SynthesisParams sp;
-  sp.coarse_passes = 2;
-  sp.cell_size = 8;
-  sp.init_subpart = 16;
-  sp.plane_weights = {1.f, 0.1f, 1.f};
-  auto synth = Synthesizer::create(table, field, sp, 0).value();
+  const ImageF stripes = testing::procedural(ProceduralKind::kStripes, 48, 48);
+  auto table = grain_table(stripes, transposed(stripes));
+  auto synth = Synthesizer::create(table, field, grain_params(), 0).value();
   const int side = 72;
   auto rgb = synth->synthesize(TargetSet::axis_cut('z', 0, -side / 2, -side / 2, side, side).value()).value();
   ImageF img(side, side, 3);
@@ -79,21 +90,8 @@ TEST(TensorFieldSynthesis, ConcentricCirclesMakeTangentialGrain) {
 TEST(ScaleField, ScaleTwoAlongXDoublesThePeriod) {
   // Stripes varying along x: xy = vertical stripes, zx = horizontal (x is zx's second axis).
   const ImageF horizontal = testing::procedural(ProceduralKind::kStripes, 48, 48);
-  ExemplarInputs in;
-  in.xy = transposed(horizontal);
-  in.yz = in.xy;
-  in.zx = horizontal;
-  AnalysisParams ap;
-  ap.levels = 3;
-  ap.neighborhood = 7;
-  ap.candidates = 8;
-  ap.pca_dims = 12;
-  auto table = analyze(ExemplarSet::create(std::move(in)).value(), ap).value().table;
-  SynthesisParams sp;
-  sp.coarse_passes = 2;
-  sp.cell_size = 8;
-  sp.init_subpart = 16;
-  sp.plane_weights = {1.f, 0.1f, 1.f};
+  auto table = grain_table(transposed(horizontal), horizontal);
+  const SynthesisParams sp = grain_params();
   auto period = [&](const char* field) {
     auto synth = Synthesizer::create(table, parse_field_spec(field).value(), sp, 0).value();
     const int w = 120, h = 12;
