@@ -17,7 +17,8 @@ using nlohmann::json;
 HttpResponse HttpResponse::json(int status, const nlohmann::json& j) {
   HttpResponse r;
   r.status = status;
-  r.body = j.dump();
+  // Never throws on bytes a client sent that are not UTF-8 (echoed ids, names): replaced.
+  r.body = j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
   return r;
 }
 

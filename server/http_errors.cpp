@@ -29,7 +29,7 @@ int http_status_for(StatusCode code) {
 
 std::string error_body(const std::string& code, const std::string& message, const std::string& field) {
   nlohmann::json j = {{"error", {{"code", code}, {"message", message}, {"field", field}}}};
-  return j.dump();
+  return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);  // messages may echo client bytes
 }
 
 std::string error_body(const Status& status) {

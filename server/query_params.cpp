@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdlib>
 
+#include "core/json_fields.h"
 #include "core/number_list.h"
 
 namespace solidtex::server {
@@ -13,6 +14,8 @@ Result<QueryParams> QueryParams::parse(const std::vector<std::pair<std::string, 
   QueryParams q;
   std::set<std::string> seen;
   for (const auto& [k, v] : query) {
+    if (!is_valid_utf8(k) || !is_valid_utf8(v))
+      return Status(StatusCode::kInvalidArgument, "a query parameter is not valid UTF-8", "query");
     if (!allowed.count(k)) {
       std::string list;
       for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;

@@ -7,6 +7,7 @@
 
 #include <set>
 #include <string>
+#include <string_view>
 
 #include "core/status.h"
 #include "core/types.h"
@@ -17,6 +18,9 @@ namespace solidtex {
 Status check_keys(const nlohmann::json& j, const std::set<std::string>& allowed, const std::string& where);
 // Parses text as JSON; a syntax error names `where` and the byte offset.
 Result<nlohmann::json> parse_json_text(const std::string& text, const std::string& where);
+
+// Well-formed UTF-8 (no overlong forms, surrogates or code points beyond U+10FFFF).
+bool is_valid_utf8(std::string_view s);
 Result<WorldPoint> json_point(const nlohmann::json& j, const std::string& where);
 Result<int64_t> json_int(const nlohmann::json& j, const std::string& where, int64_t lo, int64_t hi);
 Result<double> json_number(const nlohmann::json& j, const std::string& where, double lo, double hi);

@@ -1,5 +1,6 @@
 #include "field/frame_field.h"
 
+#include <cmath>
 #include <cstring>
 
 #include "field/field_file.h"
@@ -153,6 +154,17 @@ std::string QuatGridField::describe() const {
 
 namespace {
 
+// Beyond this a quaternion's or axis's squared norm, or an angle's sine, loses all precision
+// (1e308 squared is infinite), and the field would silently become something else.
+constexpr double kMaxSpecMagnitude = 1e6;
+
+Status check_magnitudes(const std::vector<double>& v, const char* what) {
+  for (double x : v)
+    if (!(std::fabs(x) <= kMaxSpecMagnitude))
+      return Status(StatusCode::kInvalidArgument, std::string(what) + " must be finite and within +-1e6", "field");
+  return Status::ok();
+}
+
 }  // namespace
 
 Result<std::shared_ptr<const FrameField>> parse_field_spec(const std::string& full_spec) {
@@ -170,13 +182,15 @@ Result<std::shared_ptr<const FrameField>> parse_field_spec(const std::string& fu
   if (spec == "identity") return std::shared_ptr<const FrameField>(std::make_shared<ConstantField>(Quat{}, scale));
   if (spec.rfind("quat:", 0) == 0) {
     SOLIDTEX_ASSIGN_OR_RETURN(auto v, parse_number_list(spec.substr(5), 4, "field"));
+    SOLIDTEX_RETURN_IF_ERROR(check_magnitudes(v, "quaternion components"));
     Quat q{v[0], v[1], v[2], v[3]};
     if (!(q.dot(q) > 1e-12)) return Status(StatusCode::kInvalidArgument, "quaternion must be non-zero", "field");
     return std::shared_ptr<const FrameField>(std::make_shared<ConstantField>(q, scale));
   }
   if (spec.rfind("axis:", 0) == 0) {
     SOLIDTEX_ASSIGN_OR_RETURN(auto v, parse_number_list(spec.substr(5), 4, "field"));
-    if (!(v[0] * v[0] + v[1] * v[1] + v[2] * v[2] > 0))
+    SOLIDTEX_RETURN_IF_ERROR(check_magnitudes(v, "axis components and angle"));
+    if (!(v[0] * v[0] + v[1] * v[1] + v[2] * v[2] > 1e-12))
       return Status(StatusCode::kInvalidArgument, "rotation axis must be non-zero", "field");
     return std::shared_ptr<const FrameField>(
         std::make_shared<ConstantField>(Quat::from_axis_angle(v[0], v[1], v[2], v[3] * M_PI / 180.0), scale));

@@ -88,22 +88,12 @@ Status validate_curve(const SketchCurve& c, const SketchDomain& d, int index) {
 }
 
 Result<SketchCurve> parse_curve_json(const std::string& text, int index) {
-  json j;
-  try {
-    j = json::parse(text);
-  } catch (const std::exception& e) {
-    return bad("curve", std::string("is not valid JSON: ") + e.what());
-  }
+  SOLIDTEX_ASSIGN_OR_RETURN(json j, parse_json_text(text, "curve"));
   return curve_from_json(j, index);
 }
 
 Result<Sketch> parse_sketch_json(const std::string& text) {
-  json j;
-  try {
-    j = json::parse(text);
-  } catch (const std::exception& e) {
-    return bad("sketch", std::string("is not valid JSON: ") + e.what());
-  }
+  SOLIDTEX_ASSIGN_OR_RETURN(json j, parse_json_text(text, "sketch"));
   SOLIDTEX_RETURN_IF_ERROR(check_keys(j, {"domain", "curves", "scales", "frames"}, "sketch"));
   Sketch s;
   if (!j.contains("domain")) return bad("domain", "is required");

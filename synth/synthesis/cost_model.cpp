@@ -36,15 +36,15 @@ int64_t box_volume(const VoxelBox& b) {
 
 }  // namespace
 
-std::vector<int> measure_spread(const std::vector<LevelSchedule>& schedules, const FrameStencils& stencils) {
+Result<std::vector<int>> measure_spread(const std::vector<LevelSchedule>& schedules, const FrameStencils& stencils,
+                                        LatchedInterrupter& interrupter) {
   const int L = stencils.levels();
   std::vector<int> spread(size_t(L), 0);
-  LatchedInterrupter never(null_interrupter());
   const DependencyInputs in{&schedules, &stencils, nullptr};
   // Probes at several phases of the cell and subpass lattices, which bound the spread.
   for (const int o : {0, 3, 5, 13}) {
-    auto deps = analyze_dependencies(in, TargetSet::from_voxels({{o, o, o}}, 1, 1), never);
-    if (!deps.is_ok()) continue;
+    auto deps = analyze_dependencies(in, TargetSet::from_voxels({{o, o, o}}, 1, 1), interrupter);
+    if (!deps.is_ok()) return deps.status();
     for (int l = 0; l < L; ++l) {
       const LevelDependencies& d = (*deps)[size_t(l)];
       const int V = int(d.needed.size()) - 1;

@@ -35,7 +35,9 @@ struct RequestCost {
 };
 
 // Per level (index = level), how many of its own voxels its sets reach beyond what it serves.
-std::vector<int> measure_spread(const std::vector<LevelSchedule>& schedules, const FrameStencils& stencils);
+// Takes about a second at the default parameters; cancelled through `interrupter`.
+Result<std::vector<int>> measure_spread(const std::vector<LevelSchedule>& schedules, const FrameStencils& stencils,
+                                        LatchedInterrupter& interrupter);
 
 RequestCost estimate_cost(const std::vector<LevelSchedule>& schedules, const FrameStencils& stencils,
                           const std::vector<int>& spread, const TargetSet& target);

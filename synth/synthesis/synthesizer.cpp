@@ -24,8 +24,8 @@ struct Synthesizer::Impl {
   FrameStencils stencils;
   // Per level, measured at the first estimate (cost_model.h); shared between synthesizers
   // whose schedule, stencils and constant field agree, since it depends on nothing else.
-  std::once_flag spread_once;
-  std::vector<int> spread;
+  std::mutex spread_mutex;
+  std::vector<int> spread;  // empty until measured
 };
 
 namespace {
@@ -266,38 +266,37 @@ Result<std::shared_ptr<Synthesizer>> Synthesizer::create(std::shared_ptr<const T
   return s;
 }
 
-const std::vector<int>& Synthesizer::spread() const {
-  std::call_once(impl_->spread_once, [&] {
-    static std::mutex memo_mutex;
-    static std::map<std::string, std::vector<int>> memo;
-    std::string key;
-    if (impl_->stencils.constant()) {
-      const SynthesisParams& p = params_;
-      key = std::string(scheme_name(p.scheme)) + "/" + std::to_string(p.coarse_passes) + "/" +
-            std::to_string(p.passes) + "/" + std::to_string(p.subpass_size) + "/" + std::to_string(p.cell_size) + "/" +
-            std::to_string(p.trilinear_levels) + "/" + std::to_string(table_->params().neighborhood) + "/" +
-            std::to_string(table_->levels()) + "/" + field_->describe();
-      std::lock_guard<std::mutex> g(memo_mutex);
-      if (auto it = memo.find(key); it != memo.end()) {
-        impl_->spread = it->second;
-        return;
-      }
-    }
-    impl_->spread = measure_spread(schedules_, impl_->stencils);
-    if (!key.empty()) {
-      std::lock_guard<std::mutex> g(memo_mutex);
-      memo.emplace(key, impl_->spread);
-    }
-  });
+Result<std::vector<int>> Synthesizer::spread(LatchedInterrupter& interrupter) const {
+  static std::mutex memo_mutex;
+  static std::map<std::string, std::vector<int>> memo;
+  std::lock_guard<std::mutex> g(impl_->spread_mutex);
+  if (!impl_->spread.empty()) return impl_->spread;
+  std::string key;
+  if (impl_->stencils.constant()) {
+    const SynthesisParams& p = params_;
+    key = std::string(scheme_name(p.scheme)) + "/" + std::to_string(p.coarse_passes) + "/" + std::to_string(p.passes) +
+          "/" + std::to_string(p.subpass_size) + "/" + std::to_string(p.cell_size) + "/" +
+          std::to_string(p.trilinear_levels) + "/" + std::to_string(table_->params().neighborhood) + "/" +
+          std::to_string(table_->levels()) + "/" + field_->describe();
+    std::lock_guard<std::mutex> m(memo_mutex);
+    if (auto it = memo.find(key); it != memo.end()) return impl_->spread = it->second;
+  }
+  SOLIDTEX_ASSIGN_OR_RETURN(impl_->spread, measure_spread(schedules_, impl_->stencils, interrupter));
+  if (!key.empty()) {
+    std::lock_guard<std::mutex> m(memo_mutex);
+    memo.emplace(key, impl_->spread);
+  }
   return impl_->spread;
 }
 
-RequestCost Synthesizer::estimate(const TargetSet& target) const {
+Result<RequestCost> Synthesizer::estimate(const TargetSet& target, Interrupter& interrupter) const {
+  LatchedInterrupter poller(interrupter);
+  SOLIDTEX_ASSIGN_OR_RETURN(const std::vector<int> spread, this->spread(poller));
   const auto pieces = split_target(target, kPieceCell);
-  if (pieces.size() == 1) return estimate_cost(schedules_, impl_->stencils, spread(), target);
+  if (pieces.size() == 1) return estimate_cost(schedules_, impl_->stencils, spread, target);
   RequestCost worst;
   for (const auto& piece : pieces) {
-    RequestCost c = estimate_cost(schedules_, impl_->stencils, spread(), piece_target(target, piece));
+    RequestCost c = estimate_cost(schedules_, impl_->stencils, spread, piece_target(target, piece));
     if (c.bytes > worst.bytes) worst = std::move(c);
   }
   return worst;
@@ -308,7 +307,8 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize_piece(const Ta
                                                                         const SynthesisOptions& options) {
   const int L = table_->levels();
   if (options.max_bytes > 0) {
-    const RequestCost cost = estimate_cost(schedules_, impl_->stencils, spread(), target);
+    SOLIDTEX_ASSIGN_OR_RETURN(const std::vector<int> spread, this->spread(poller));
+    const RequestCost cost = estimate_cost(schedules_, impl_->stencils, spread, target);
     stats.estimated_bytes = cost.bytes;
     if (cost.bytes > options.max_bytes) return too_much_memory(cost.bytes, options.max_bytes);
   }

@@ -79,7 +79,9 @@ class Synthesizer {
 
   // Upper bounds of what synthesize(target) allocates, per level (cost_model.h). Scattered
   // targets are split into compact pieces first; this is the cost of the largest piece.
-  RequestCost estimate(const TargetSet& target) const;
+  // The first call measures the schedule's spread (about a second; memoised per schedule and
+  // constant field), cancelled through `interrupter`.
+  Result<RequestCost> estimate(const TargetSet& target, Interrupter& interrupter = null_interrupter()) const;
 
   const Table& table() const { return *table_; }
   const FrameField& field() const { return *field_; }
@@ -89,7 +91,7 @@ class Synthesizer {
 
  private:
   Synthesizer() = default;
-  const std::vector<int>& spread() const;
+  Result<std::vector<int>> spread(LatchedInterrupter& interrupter) const;
   // One compact piece of a request: colors per target voxel (target.voxels order).
   Result<std::vector<std::array<float, 3>>> synthesize_piece(const TargetSet& piece, LatchedInterrupter& poller,
                                                              SynthesisStats& stats, const SynthesisOptions& options);

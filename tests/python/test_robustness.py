@@ -1,0 +1,230 @@
+"""Issue 11: requests that used to crash, exhaust or wedge the service, replayed against a live
+server. Each answers a clear 4xx/503/504 (or succeeds, where the request is legitimate) and
+the process stays up and keeps answering."""
+from __future__ import annotations
+
+import json
+import socket
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+import requests
+from PIL import Image
+
+from support import ANALYSIS, HTTP_TIMEOUT, RAW, RAW_F32, ServerFactory, assert_error, post_bytes, upload_ready
+
+
+@pytest.fixture(scope="module")
+def srv(binary, exemplars, tmp_path_factory):
+    """A server with the wood exemplar analysed (small parameters)."""
+    factory = ServerFactory(tmp_path_factory.mktemp("robustness"))
+    try:
+        s = factory.start("--threads", "2")
+        ex = upload_ready(s.client, exemplars["wood"])
+        s.exemplar_id = ex["id"]
+        yield s
+    finally:
+        factory.close()
+
+
+def alive(s) -> None:
+    r = requests.get(f"{s.url}/healthz", timeout=10)
+    assert r.status_code == 200, r.text
+    assert s.running, s.log()
+
+
+def create_volume(s, **body) -> requests.Response:
+    return requests.post(f"{s.url}/v1/volumes", json={"exemplar": s.exemplar_id, **body}, timeout=HTTP_TIMEOUT)
+
+
+def slice_of(s, vid: str, **params) -> requests.Response:
+    q = {"axis": "z", "at": 0, "size": "2,2", **params}
+    return requests.get(f"{s.url}/v1/volumes/{vid}/slice", params=q, headers=RAW_F32, timeout=HTTP_TIMEOUT)
+
+
+def test_inline_identity_field_spec_makes_a_working_volume(srv):
+    r = create_volume(srv, field={"spec": "identity"})
+    assert r.status_code == 201, r.text
+    got = slice_of(srv, r.json()["id"])
+    assert got.status_code == 200, got.text
+    plain = create_volume(srv)  # no field at all: the same identity field, the same bits
+    assert slice_of(srv, plain.json()["id"]).content == got.content
+    alive(srv)
+
+
+@pytest.mark.parametrize("spec", ["identity;scale:2.1,1,1", "axis:0,0,1,30;scale:3,1,1"])
+def test_stretched_fields_synthesize_instead_of_crashing(srv, spec):
+    r = create_volume(srv, field={"spec": spec})
+    assert r.status_code == 201, r.text
+    got = slice_of(srv, r.json()["id"])
+    assert got.status_code == 200, got.text
+    assert np.isfinite(np.frombuffer(got.content, np.float32)).all()
+    alive(srv)
+
+
+@pytest.mark.parametrize("spec", ["quat:1e308,0,0,1", "axis:0,0,1,1e308", "axis:1e308,0,0,30"])
+def test_field_specs_that_lose_all_precision_are_refused(srv, spec):
+    assert_error(create_volume(srv, field={"spec": spec}), 400, field_contains="field")
+    alive(srv)
+
+
+def test_float_exemplar_beyond_half_float_range_is_refused_at_upload(srv, tmp_path):
+    rng = np.random.default_rng(1)
+    img = (rng.random((48, 48)) * 1e20).astype(np.float32)
+    path = tmp_path / "huge.tif"
+    Image.fromarray(img, mode="F").save(path)
+    r = post_bytes(f"{srv.url}/v1/exemplars", path.read_bytes(), params=ANALYSIS)
+    err = assert_error(r, (400, 422))
+    assert "65504" in err["message"], err
+    alive(srv)
+
+
+def test_line_shaped_cut_is_refused_by_the_cost_model_at_once(srv):
+    vid = create_volume(srv).json()["id"]
+    t0 = time.monotonic()
+    r = slice_of(srv, vid, size="4194304,1", timeout=5)
+    err = assert_error(r, 422, field_contains="size")
+    assert "MB of working memory" in err["message"], err
+    assert time.monotonic() - t0 < 5
+    alive(srv)
+
+
+def test_points_far_apart_cost_what_each_costs_alone(srv):
+    vid = create_volume(srv).json()["id"]
+    url = f"{srv.url}/v1/volumes/{vid}/points"
+    pts = [[0, 0, 0], [4000, 0, 0]]
+    both = requests.post(url, json={"points": pts}, headers=RAW_F32, timeout=HTTP_TIMEOUT)
+    assert both.status_code == 200, both.text
+    # Fresh volumes with the same spec give the same bits (purity): ask each point alone.
+    for i, p in enumerate(pts):
+        other = create_volume(srv).json()["id"]
+        one = requests.post(f"{srv.url}/v1/volumes/{other}/points", json={"points": [p]}, headers=RAW_F32,
+                            timeout=HTTP_TIMEOUT)
+        assert one.status_code == 200, one.text
+        assert one.content == both.content[12 * i:12 * (i + 1)]
+    alive(srv)
+
+
+def test_cut_with_huge_steps_is_answered_not_a_500(srv):
+    vid = create_volume(srv).json()["id"]
+    r = requests.post(f"{srv.url}/v1/volumes/{vid}/cut", headers=RAW_F32, timeout=HTTP_TIMEOUT,
+                      json={"origin": [0, 0, 0], "u": [1e8, 0, 0], "v": [0, 1, 0], "size": [2, 1]})
+    assert r.status_code in (200, 400, 422), r.text
+    alive(srv)
+
+
+def test_overflowing_field_grid_is_refused(srv):
+    sketch = {"domain": {"min": [0, 0, 0], "max": [1.1e9, 1, 1]},
+              "curves": [{"axis": "x", "plane_normal": [0, 0, 1], "points": [[0, 0, 0], [10, 0.5, 0.5]]}]}
+    r = requests.post(f"{srv.url}/v1/fields", json=sketch, timeout=HTTP_TIMEOUT)
+    assert_error(r, (413, 422), field_contains="domain")
+    alive(srv)
+
+
+def big_sketch() -> dict:
+    return {"domain": {"min": [0, 0, 0], "max": [64, 64, 64], "shortest_side_cells": 60},
+            "curves": [{"axis": "x", "plane_normal": [0, 0, 1],
+                        "points": [[8, 8, 30], [32, 40, 30], [56, 12, 30]]}]}
+
+
+def test_field_solve_honours_its_deadline(srv):
+    t0 = time.monotonic()
+    r = requests.post(f"{srv.url}/v1/fields", params={"timeout": 1}, json=big_sketch(), timeout=HTTP_TIMEOUT)
+    took = time.monotonic() - t0
+    assert_error(r, 504, field_contains="timeout")
+    assert took < 2.0, took
+    alive(srv)
+
+
+def test_synthesis_honours_its_deadline(srv):
+    vid = create_volume(srv, seed=11).json()["id"]
+    t0 = time.monotonic()
+    r = slice_of(srv, vid, size="160,160", timeout=1)
+    took = time.monotonic() - t0
+    assert_error(r, 504, field_contains="timeout")
+    assert took < 2.0, took
+    alive(srv)
+
+
+def test_duplicate_json_keys_are_refused(srv):
+    body = '{"exemplar": "%s", "seed": 1, "seed": 2}' % srv.exemplar_id
+    r = requests.post(f"{srv.url}/v1/volumes", data=body, headers={"Content-Type": "application/json"}, timeout=30)
+    err = assert_error(r, 400)
+    assert "seed" in err["message"], err
+    alive(srv)
+
+
+def test_non_utf8_json_body_is_a_400_without_echoing_bytes(srv):
+    r = requests.post(f"{srv.url}/v1/volumes", data=b'{"exemplar": "\xff\xfe"}',
+                      headers={"Content-Type": "application/json"}, timeout=30)
+    assert_error(r, 400)
+    assert b"\xff" not in r.content
+    alive(srv)
+
+
+def test_raw_0xff_in_the_path_is_a_4xx(srv):
+    host, port = srv.url.split("//", 1)[1].split(":")
+    with socket.create_connection((host, int(port)), timeout=10) as sock:
+        sock.sendall(b"GET /v1/volumes/\xff HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n")
+        answer = b""
+        while b"\r\n" not in answer:
+            chunk = sock.recv(4096)
+            if not chunk:
+                break
+            answer += chunk
+    status = int(answer.split(b" ", 2)[1])
+    assert 400 <= status < 500, answer[:200]
+    alive(srv)
+
+
+def slow_exemplar(tmp_path: Path) -> bytes:
+    """A 160x160 noise exemplar: its default analysis takes seconds on 2 cores."""
+    rng = np.random.default_rng(5)
+    path = tmp_path / "slow.png"
+    Image.fromarray((rng.random((160, 160, 3)) * 255).astype(np.uint8)).save(path)
+    return path.read_bytes()
+
+
+def wait_running(s, job: str, seconds: float = 30) -> None:
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        state = s.client.get_job(job)["state"]
+        if state == "running":
+            return
+        assert state == "queued", state
+        time.sleep(0.05)
+    raise AssertionError("the analysis never started")
+
+
+def test_delete_cancels_a_running_analysis(srv, tmp_path):
+    r = post_bytes(f"{srv.url}/v1/exemplars", slow_exemplar(tmp_path))
+    assert r.status_code == 202, r.text
+    up = r.json()
+    wait_running(srv, up["job"]["id"])
+    t0 = time.monotonic()
+    d = requests.delete(f"{srv.url}/v1/exemplars/{up['exemplar']['id']}", timeout=60)
+    assert d.status_code in (200, 204), d.text
+    assert time.monotonic() - t0 < 5
+    assert requests.get(f"{srv.url}/v1/exemplars/{up['exemplar']['id']}", timeout=10).status_code == 404
+    alive(srv)
+
+
+def test_an_analysis_that_kills_the_server_twice_is_marked_failed(server, tmp_path):
+    body = slow_exemplar(tmp_path)
+    first = server("--threads", "1")
+    r = post_bytes(f"{first.url}/v1/exemplars", body)
+    assert r.status_code == 202, r.text
+    ex, job = r.json()["exemplar"]["id"], r.json()["job"]["id"]
+    wait_running(first, job)
+    first.kill()  # dies mid-analysis: acknowledged, so it is re-queued once
+    second = server("--threads", "1", data_dir=first.data_dir)
+    wait_running(second, job)
+    second.kill()  # dies again: a poison pill
+    third = server("--threads", "1", data_dir=first.data_dir)
+    state = third.client.get_job(job)
+    assert state["state"] == "failed", state
+    assert "not retried" in state["error"]["message"], state
+    assert third.client.get_exemplar(ex)["id"] == ex  # the upload itself is kept
+    alive(third)
