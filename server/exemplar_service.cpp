@@ -23,7 +23,6 @@ namespace {
 
 enum class State { kQueued, kRunning, kReady, kFailed };
 
-const char* kPartNames[] = {"xy", "yz", "zx", "mask", "mask_yz", "mask_zx"};
 
 std::string job_id_of(const std::string& exemplar_id) { return "job_" + exemplar_id.substr(3); }
 
@@ -302,6 +301,12 @@ Result<json> ExemplarService::upload(ExemplarUpload up) {
   params.search_k = std::max(params.search_k, params.candidates / 2 + 1);
   SOLIDTEX_RETURN_IF_ERROR(params.validate());
   SOLIDTEX_ASSIGN_OR_RETURN(ExemplarSet set, impl_->build_set(up.parts, up.grain, up.mask_weight, params));
+  if (const int64_t bytes = estimate_analysis_bytes(set, params); bytes > impl_->config.max_request_bytes)
+    return Status(StatusCode::kUnprocessable,
+                  "analysing this exemplar needs about " + std::to_string(bytes >> 20) + " MB; the limit is " +
+                      std::to_string(impl_->config.max_request_bytes >> 20) +
+                      " MB (--max-request-mb): send a smaller image or fewer levels",
+                  "xy");
 
   const std::string id = DataStore::new_id("ex_");
   json parts = json::array();

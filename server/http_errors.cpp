@@ -10,7 +10,9 @@ int http_status_for(StatusCode code) {
     case StatusCode::kInvalidArgument: return 400;
     case StatusCode::kNotFound: return 404;
     case StatusCode::kUnsupported: return 415;
-    case StatusCode::kTooLarge: return 413;
+    // Asking for too much (voxels, grid nodes) is unusable content, 422; 413 is only ever the
+    // HTTP layer's answer to a body over --max-upload-mb (http_server.cpp), as the contract says.
+    case StatusCode::kTooLarge:
     case StatusCode::kCorrupt:
     case StatusCode::kVersionMismatch:
     case StatusCode::kUnprocessable: return 422;

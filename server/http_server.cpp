@@ -183,6 +183,8 @@ class Server {
     return r;
   }
 
+  static constexpr size_t kMaxParts = 16;
+
   // Splits a multipart/form-data body into named parts.
   Status split_parts(const restinio::request_handle_t& req, HttpRequest& hr) {
     namespace hfp = restinio::http_field_parsers;
@@ -203,6 +205,11 @@ class Server {
           const auto name = hfp::find_first(parsed->parameters, "name");
           if (!name) {
             st = Status(StatusCode::kInvalidArgument, "a part's Content-Disposition has no name", "body");
+            return restinio::multipart_body::handling_result_t::terminate_enumeration;
+          }
+          // No endpoint takes more than six parts; a body of thousands must not cost quadratic work.
+          if (hr.parts.size() >= kMaxParts) {
+            st = Status(StatusCode::kInvalidArgument, "has more than " + std::to_string(kMaxParts) + " parts", "body");
             return restinio::multipart_body::handling_result_t::terminate_enumeration;
           }
           hr.parts.emplace_back(std::string(name->data(), name->size()), std::string(part.body.data(), part.body.size()));

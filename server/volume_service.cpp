@@ -29,6 +29,7 @@ struct Volume {
   uint32_t seed = 1;
   // Built at the first query.
   std::mutex build_mutex;
+  json pending_surface;  // a loaded volume's surface label: its distance band is built at first use
   std::vector<std::shared_ptr<Synthesizer>> synths;
   std::shared_ptr<RegionVolume> regions;
   // Statistics.
@@ -86,7 +87,8 @@ struct VolumeService::Impl {
     SOLIDTEX_ASSIGN_OR_RETURN(Mesh mesh, meshes.decode(bytes));
     SOLIDTEX_ASSIGN_OR_RETURN(Placement placement,
                               placement_from_json(mesh_spec.value("placement", json::object()), "regions.mesh.placement", mesh.bounds(), nullptr));
-    SOLIDTEX_ASSIGN_OR_RETURN(v.label->surface, SurfaceDistance::create(mesh, placement, v.label->distance + 1));
+    SOLIDTEX_ASSIGN_OR_RETURN(v.label->surface, SurfaceDistance::create(mesh, placement, v.label->distance + 1,
+                                                                        config.max_request_bytes));
     return Status::ok();
   }
 
@@ -182,6 +184,12 @@ struct VolumeService::Impl {
   Status build(Volume& v) {
     std::lock_guard<std::mutex> g(v.build_mutex);
     if (!v.synths.empty()) return Status::ok();
+    if (!v.pending_surface.is_null()) {  // start-up never builds unbounded work before listening
+      SOLIDTEX_ASSIGN_OR_RETURN(auto bytes,
+                                store.read(ResourceKind::kVolume, v.info["id"].get<std::string>(), "mesh.source"));
+      SOLIDTEX_RETURN_IF_ERROR(attach_surface(v, v.pending_surface, bytes));
+      v.pending_surface = nullptr;
+    }
     std::vector<std::shared_ptr<Synthesizer>> synths;
     for (const std::string& eid : v.exemplar_ids) {
       SOLIDTEX_ASSIGN_OR_RETURN(auto table, exemplars.table(eid));
@@ -250,8 +258,9 @@ Status VolumeService::start(std::vector<std::string>* report) {
         v->field = field;
       }
       if (v->label && v->label->kind == RegionLabel::Kind::kSurfaceShell) {
-        SOLIDTEX_ASSIGN_OR_RETURN(auto bytes, impl_->store.read(ResourceKind::kVolume, id, "mesh.source"));
-        SOLIDTEX_RETURN_IF_ERROR(impl_->attach_surface(*v, spec["regions"]["mesh"], bytes));
+        if (!impl_->store.exists(ResourceKind::kVolume, id, "mesh.source"))
+          return Status(StatusCode::kCorrupt, "the volume's mesh copy is missing", "mesh.source");
+        v->pending_surface = spec["regions"]["mesh"];
       }
       v->info = info;
       return v;

@@ -103,4 +103,13 @@ Result<AnalysisResult> analyze(const ExemplarSet& exemplars, const AnalysisParam
   return result;
 }
 
+int64_t estimate_analysis_bytes(const ExemplarSet& exemplars, const AnalysisParams& params) {
+  const int64_t planes = exemplars.shared() ? 1 : 3;
+  const int64_t c = exemplars.channels();
+  const int64_t per_pixel_level = 16 * params.neighborhood * c + 8 * params.pca_dims + 48 * params.candidates + 128;
+  int64_t pixels = 0;
+  for (int k = 0; k < int(planes); ++k) pixels += exemplars.plane(plane_from_index(k)).pixel_count();
+  return pixels * params.levels * per_pixel_level;
+}
+
 }  // namespace solidtex

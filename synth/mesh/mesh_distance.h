@@ -16,7 +16,14 @@ namespace solidtex {
 
 class SurfaceDistance {
  public:
-  static Result<std::shared_ptr<const SurfaceDistance>> create(const Mesh& mesh, const Placement& placement, double band);
+  // `max_bytes` (0 = none): refuse with kUnprocessable, before building, when estimate_bytes()
+  // exceeds it.
+  static Result<std::shared_ptr<const SurfaceDistance>> create(const Mesh& mesh, const Placement& placement, double band,
+                                                               int64_t max_bytes = 0);
+  // The narrow band's memory: placed surface area x (2 band + one leaf of padding) voxels, at
+  // 5 bytes each (float value plus OpenVDB tree overhead). An upper bound for meshes whose
+  // triangles do not overlap.
+  static int64_t estimate_bytes(const Mesh& mesh, const Placement& placement, double band);
   ~SurfaceDistance();
   // Distance in world units from p to the surface; > band() when farther than the band.
   double at(const WorldPoint& p) const;

@@ -119,7 +119,7 @@ def test_overflowing_field_grid_is_refused(srv):
     sketch = {"domain": {"min": [0, 0, 0], "max": [1.1e9, 1, 1]},
               "curves": [{"axis": "x", "plane_normal": [0, 0, 1], "points": [[0, 0, 0], [10, 0.5, 0.5]]}]}
     r = requests.post(f"{srv.url}/v1/fields", json=sketch, timeout=HTTP_TIMEOUT)
-    assert_error(r, (413, 422), field_contains="domain")
+    assert_error(r, 422, field_contains="domain")  # the contract keeps 413 for bodies over the upload limit
     alive(srv)
 
 
@@ -228,3 +228,60 @@ def test_an_analysis_that_kills_the_server_twice_is_marked_failed(server, tmp_pa
     assert "not retried" in state["error"]["message"], state
     assert third.client.get_exemplar(ex)["id"] == ex  # the upload itself is kept
     alive(third)
+
+
+def test_huge_blank_png_is_refused_by_the_analysis_cost_model(srv, tmp_path):
+    path = tmp_path / "blank.png"
+    Image.new("RGB", (4096, 4096)).save(path)  # ~16 KB on disk, 16.7M pixels
+    t0 = time.monotonic()
+    r = post_bytes(f"{srv.url}/v1/exemplars", path.read_bytes())
+    if r.status_code == 422 and "pixels" in r.json()["error"]["message"]:
+        pytest.skip("refused by --max-image-pixels before the cost model: " + r.json()["error"]["message"])
+    err = assert_error(r, 422)
+    assert "MB" in err["message"] and "--max-request-mb" in err["message"], err
+    assert time.monotonic() - t0 < 20
+    alive(srv)
+
+
+CUBE_OFF = b"""OFF
+8 12 0
+0 0 0
+1 0 0
+1 1 0
+0 1 0
+0 0 1
+1 0 1
+1 1 1
+0 1 1
+3 0 2 1
+3 0 3 2
+3 4 5 6
+3 4 6 7
+3 0 1 5
+3 0 5 4
+3 2 3 7
+3 2 7 6
+3 1 2 6
+3 1 6 5
+3 0 4 7
+3 0 7 3
+"""
+
+
+def test_surface_band_beyond_the_memory_limit_is_refused_at_creation(srv):
+    r = post_bytes(f"{srv.url}/v1/meshes", CUBE_OFF, params={"name": "cube"})
+    assert r.status_code == 201, r.text
+    mesh = r.json()["id"]
+
+    def regions(resolution: int, label: str) -> requests.Response:
+        return requests.post(f"{srv.url}/v1/volumes", timeout=HTTP_TIMEOUT, json={"regions": {
+            "exemplars": [srv.exemplar_id, srv.exemplar_id], "label": label,
+            "mesh": {"id": mesh, "placement": {"resolution": resolution}}}})
+
+    t0 = time.monotonic()
+    err = assert_error(regions(2048, "surface:64"), 422, field_contains="regions")
+    assert "MB" in err["message"], err
+    assert time.monotonic() - t0 < 10
+    ok = regions(64, "surface:2")
+    assert ok.status_code == 201, ok.text
+    alive(srv)
