@@ -92,4 +92,59 @@ double neighborhood_energy(const ImageF& cut, const ImageF& exemplar, int n, int
   return centres.empty() ? 0.0 : sum / double(centres.size());
 }
 
+double coverage(const ImageF& cut, const ImageF& exemplar, int n, int stride) {
+  const int dims = neighborhood_dims(n, cut.channels);
+  const int h = n / 2;
+  std::vector<float> in_cut;
+  for (int y = h; y + h < cut.height; ++y)
+    for (int x = h; x + h < cut.width; ++x) {
+      in_cut.resize(in_cut.size() + size_t(dims));
+      gather_neighborhood(cut, {x, y}, n, 1, &in_cut[in_cut.size() - size_t(dims)]);
+    }
+  const int count = int(in_cut.size() / size_t(dims));
+  std::vector<std::pair<int, int>> centres;
+  for (int y = 0; y < exemplar.height; y += stride)
+    for (int x = 0; x < exemplar.width; x += stride) centres.emplace_back(x, y);
+  if (count == 0 || centres.empty()) return 0.0;
+  std::vector<double> best(centres.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, centres.size()), [&](const tbb::blocked_range<size_t>& r) {
+    std::vector<float> q(static_cast<size_t>(dims));
+    std::vector<int> idx;
+    std::vector<float> dist;
+    for (size_t i = r.begin(); i != r.end(); ++i) {
+      gather_neighborhood(exemplar, {centres[i].first, centres[i].second}, n, 1, q.data());
+      exact_knn(in_cut.data(), count, dims, q.data(), 1, idx, dist);
+      best[i] = dist[0] / dims;
+    }
+  });
+  double sum = 0;
+  for (double b : best) sum += b;
+  return sum / double(centres.size());
+}
+
+namespace {
+double luminance(const ImageF& img, int x, int y) {
+  const float* p = img.wrapped(x, y);
+  return img.channels >= 3 ? 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2] : p[0];
+}
+double mean_gradient(const ImageF& img, bool toroidal) {
+  double sum = 0;
+  int64_t count = 0;
+  const int w = toroidal ? img.width : img.width - 1, hgt = toroidal ? img.height : img.height - 1;
+  for (int y = 0; y < hgt; ++y)
+    for (int x = 0; x < w; ++x) {
+      const double l = luminance(img, x, y);
+      const double gx = luminance(img, x + 1, y) - l, gy = luminance(img, x, y + 1) - l;
+      sum += std::sqrt(gx * gx + gy * gy);
+      ++count;
+    }
+  return count ? sum / double(count) : 0.0;
+}
+}  // namespace
+
+double sharpness_ratio(const ImageF& cut, const ImageF& exemplar) {
+  const double e = mean_gradient(exemplar, true);
+  return e > 0 ? mean_gradient(cut, false) / e : 0.0;
+}
+
 }  // namespace solidtex

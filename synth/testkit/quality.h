@@ -16,6 +16,17 @@ double dominant_period_x(const ImageF& image);
 // Neighborhood-matching energy: the mean, over every N x N neighborhood that fits inside
 // `cut` (taken every `stride` pixels), of the squared distance per element to its nearest
 // neighborhood of `exemplar` (toroidal). Lower means the cut looks more like the exemplar.
+// It rewards blur (a smooth neighborhood always finds a smooth match): judge synthesis with
+// coverage() and sharpness_ratio() too, which see blur and missing variety.
 double neighborhood_energy(const ImageF& cut, const ImageF& exemplar, int n, int stride = 1);
+
+// The other direction: the mean, over exemplar N x N neighborhoods (every `stride` pixels,
+// toroidal), of the squared distance per element to the nearest neighborhood inside `cut`.
+// High when the cut misses detail or variety of the exemplar (blur, repetition, blobs).
+double coverage(const ImageF& cut, const ImageF& exemplar, int n, int stride = 1);
+
+// Mean gradient magnitude of luminance (forward differences) of `cut` (inside it) over that of
+// `exemplar` (toroidal): about 1 when the cut is as crisp as the exemplar, well below when blurred.
+double sharpness_ratio(const ImageF& cut, const ImageF& exemplar);
 
 }  // namespace solidtex

@@ -1,0 +1,137 @@
+#!/usr/bin/env python3
+"""Quality benchmark (issue 12): cuts of solid textures scored against their exemplars, next to
+Embark's 2D texture-synthesis on the same exemplar and size.
+
+  bench_quality.py BUILD [--size 256] [--exemplars a.png,b.png] [--out DIR] [--no-embark]
+
+For every exemplar in ../shared/data/exemplars (wood_grain and wood_planks analysed with
+--grain x, the rest with defaults): z, y and x cuts and one oblique cut of SIZE^2 through the
+origin, scored with ../shared/tools/texmetric.py (swd, coverage, energy, sharp; read its header:
+energy alone rewards blur). Embark 2D (../shared/tools/embark-ref, built into BUILD/embark-ref
+with cargo on first use) synthesizes SIZE^2 from the same exemplar. Prints one JSON document
+with per-cut scores, per-exemplar worst-of-four swd over Embark's, and the issue's summary
+measures; writes a montage PNG per exemplar (exemplar | z | y | x | oblique | Embark) into DIR.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+from PIL import Image
+
+REPO = Path(__file__).resolve().parents[1]
+SHARED = REPO.parent / "shared"
+GRAIN_X = {"wood_grain", "wood_planks"}
+# The oblique cut: the plane through the origin spanned by two orthonormal steps.
+OBLIQUE = "0,0,0,0.6,0.8,0,-0.48,0.36,0.8"
+
+
+def run(cmd, **kw) -> subprocess.CompletedProcess:
+    return subprocess.run([str(c) for c in cmd], check=True, capture_output=True, text=True, **kw)
+
+
+def texmetric(python: str, image: Path, exemplar: Path) -> dict:
+    out = run([python, SHARED / "tools" / "texmetric.py", image, exemplar]).stdout
+    return json.loads(out.strip().splitlines()[-1])
+
+
+def embark_binary(build: Path) -> Path | None:
+    binary = build / "embark-ref" / "release" / "embark-ref"
+    if binary.exists():
+        return binary
+    manifest = SHARED / "tools" / "embark-ref" / "Cargo.toml"
+    if not manifest.exists():
+        return None
+    subprocess.run(["cargo", "build", "--release", "--manifest-path", str(manifest), "--target-dir",
+                    str(build / "embark-ref")], check=True, capture_output=True)
+    return binary
+
+
+def montage(paths: list[Path], out: Path, tile: int = 256) -> None:
+    images = [Image.open(p).convert("RGB") for p in paths]
+    images = [im.resize((tile, tile), Image.NEAREST) for im in images]
+    sheet = Image.new("RGB", (len(images) * (tile + 4) - 4, tile), (255, 255, 255))
+    for k, im in enumerate(images):
+        sheet.paste(im, (k * (tile + 4), 0))
+    sheet.save(out)
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("build", type=Path)
+    ap.add_argument("--size", type=int, default=256)
+    ap.add_argument("--exemplars", default="")
+    ap.add_argument("--out", type=Path, default=None)
+    ap.add_argument("--no-embark", action="store_true")
+    args = ap.parse_args()
+    build = args.build.resolve()
+    solidtex = build / "bin" / "solidtex"
+    python = str(build / "venv" / "bin" / "python") if (build / "venv").exists() else sys.executable
+    ex_dir = SHARED / "data" / "exemplars"
+    if args.exemplars:
+        exemplars = [Path(p) for p in args.exemplars.split(",")]
+    elif ex_dir.exists():
+        exemplars = sorted(ex_dir.glob("*.png"))
+    else:
+        print(json.dumps({"skipped": "no ../shared/data/exemplars"}))
+        return 0
+    out_dir = args.out or build / "bench-quality"
+    out_dir.mkdir(parents=True, exist_ok=True)
+    embark = None if args.no_embark else embark_binary(build)
+    n = args.size
+    results = []
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        for ex in exemplars:
+            name = ex.stem
+            table = tmp / f"{name}.stx"
+            grain = ["--grain", "x"] if name in GRAIN_X else []
+            run([solidtex, "analyze", ex, *grain, "-o", table])
+            cuts = {"z": ["--axis", "z", "--at", "0"], "y": ["--axis", "y", "--at", "0"],
+                    "x": ["--axis", "x", "--at", "0"], "oblique": ["--plane", OBLIQUE]}
+            entry = {"exemplar": name, "grain": "x" if grain else "", "size": n, "cuts": {}}
+            images = [ex]
+            for cut, where in cuts.items():
+                image = out_dir / f"{name}_{cut}.png"
+                stats = tmp / f"{name}_{cut}.json"
+                t0 = time.monotonic()
+                run([solidtex, "slice", table, *where, "--size", f"{n},{n}", "-o", image, "--stats", stats])
+                seconds = time.monotonic() - t0
+                scores = texmetric(python, image, ex)
+                scores["seconds"] = round(seconds, 2)
+                scores["voxels"] = json.loads(stats.read_text())["voxels"]
+                entry["cuts"][cut] = scores
+                images.append(image)
+            if embark:
+                image = out_dir / f"{name}_embark.png"
+                run([embark, ex, n, image, 1])
+                entry["embark"] = texmetric(python, image, ex)
+                images.append(image)
+                worst = max(c["swd"] for c in entry["cuts"].values())
+                entry["worst_swd_over_embark"] = round(worst / entry["embark"]["swd"], 3)
+            axis_mean = np.mean([entry["cuts"][c]["swd"] for c in ("z", "y", "x")])
+            entry["oblique_over_axis_swd"] = round(entry["cuts"]["oblique"]["swd"] / axis_mean, 3)
+            montage(images, out_dir / f"{name}_montage.png")
+            results.append(entry)
+            print(f"{name}: " + " ".join(f"{c}={v['swd']:.3f}/{v['sharp']:.2f}" for c, v in entry["cuts"].items())
+                  + (f" embark={entry['embark']['swd']:.3f}/{entry['embark']['sharp']:.2f}" if embark else ""),
+                  file=sys.stderr)
+    sharp = [c["sharp"] for e in results for c in e["cuts"].values()]
+    summary = {"median_sharp": float(np.median(sharp)), "min_sharp": float(np.min(sharp)),
+               "max_oblique_over_axis_swd": max(e["oblique_over_axis_swd"] for e in results)}
+    ratios = [e["worst_swd_over_embark"] for e in results if "worst_swd_over_embark" in e]
+    if ratios:
+        summary.update({"median_worst_swd_over_embark": float(np.median(ratios)),
+                        "max_worst_swd_over_embark": float(np.max(ratios))})
+    print(json.dumps({"size": n, "montages": str(out_dir), "exemplars": results, "summary": summary}, indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
