@@ -3,52 +3,133 @@
 
 Edit this file, run `python3 proto/openapi.py`, commit both. `--check` fails when the JSON is
 stale (a ctest runs it); server/routes_test.cpp checks the routes against the JSON.
+
+The request-body schemas of sketches and volume specs live in proto/sketch.schema.json and
+proto/volume.schema.json (JSON Schema 2020-12, the dialect of OpenAPI 3.1); they are bundled
+here under components/schemas (their $defs become components of their own), so that the
+document is self-contained and every $ref resolves inside it.
+
+The ranges below are the server's: a request the schemas accept is refused only for reasons
+that JSON Schema cannot state, and each such reason is named in a description (cross-field
+rules, image and mesh contents, the per-request budgets of `solidtex serve` flags: 422).
+Tests: tests/python/test_contract.py runs schemathesis over the served document.
 """
 import json
+import pathlib
+
+HERE = pathlib.Path(__file__).resolve().parent
+MAX_COORD = 1 << 28   # world coordinates, voxel indices (synth/synthesis/target.cpp)
+MAX_SIDE = 1 << 24    # pixels per side of a slice, voxels per side of a region (the ceiling of --max-voxels)
+MAX_CUT_SIDE = 1 << 20  # pixels per side of a cut
+MAX_ORIGIN = MAX_COORD - MAX_SIDE  # origin/min of a slice or region: origin + size stays within 2^28
+MAX_SEED = 1 << 30
+ID_MAX = 64           # characters of an id named in a body
+
+
 def ref(n): return {"$ref": f"#/components/schemas/{n}"}
 def err(desc): return {"description": desc, "content": {"application/json": {"schema": ref("Error")}}}
 def js(schema, desc="OK"): return {"description": desc, "content": {"application/json": {"schema": schema}}}
 def qp(name, desc, schema=None, required=False):
     return {"name": name, "in": "query", "required": required, "description": desc, "schema": schema or {"type": "string"}}
-def pid(desc="Opaque id."): return {"name": "id", "in": "path", "required": True, "description": desc, "schema": {"type": "string"}}
-timeout = qp("timeout", "Deadline in seconds for this request, (0, server max]; default: the server's --deadline (30 s). Past it the synthesis is cancelled and the answer is 504.", {"type": "number"})
-E = {"400": err("Malformed request: bad JSON, unknown key or query parameter, value out of range; `field` names it."),
+def qlist(name, desc, items, n, required=False):
+    """A query parameter of exactly n comma-separated values (`size=W,H`)."""
+    return {"name": name, "in": "query", "required": required, "description": desc, "style": "form", "explode": False,
+            "schema": {"type": "array", "items": items, "minItems": n, "maxItems": n}}
+def pid(desc="Opaque id."): return {"name": "id", "in": "path", "required": True, "description": desc, "schema": {"type": "string", "minLength": 1}}
+def integer(lo, hi, **kw): return {"type": "integer", "minimum": lo, "maximum": hi, **kw}
+def number(lo, hi, **kw): return {"type": "number", "minimum": lo, "maximum": hi, **kw}
+coord = number(-MAX_COORD, MAX_COORD)
+vec3 = {"type": "array", "items": coord, "minItems": 3, "maxItems": 3}
+timeout = qp("timeout", "Deadline in seconds for this request, (0, --max-deadline] (default 300 s; a server started with another --max-deadline serves that maximum here); default: the server's --deadline (30 s). "
+             "Past it the synthesis is cancelled and the answer is 504.", {"type": "number", "exclusiveMinimum": 0, "maximum": 300})
+LIMITS_422 = ("Well-formed but over a per-request budget of the server (flags of `solidtex serve`): more output samples than --max-voxels "
+              "(default 4194304), working memory estimated above --max-request-mb (default 1536; the cost model runs before any work), "
+              "a field grid above --max-field-nodes (default 262144), a mesh above --max-mesh-vertices/--max-mesh-faces; or unusable "
+              "content (a corrupt image or mesh, an image smaller than 8 or larger than --max-image-side pixels per side).")
+E = {"400": err("Malformed request: bad JSON, unknown key or query parameter, value out of range, a rule between fields broken; `field` names it."),
      "404": err("No such resource."), "405": err("Method not allowed on this path."),
-     "413": err("Body larger than the upload limit."), "415": err("Unsupported Content-Type or image format."),
-     "422": err("Well-formed but unusable: image too large in pixels (checked from its header), corrupt image, too many voxels."),
-     "429": err("Too many concurrent analysis jobs."), "503": err("Worker queue full (see Retry-After) or shutting down."),
+     "413": err("Body larger than --max-upload-mb (default 64 MiB); no other request is answered 413."),
+     "415": err("Unsupported Content-Type, or an image or mesh format that is not recognised from its bytes."),
+     "422": err(LIMITS_422),
+     "429": err("Too many concurrent analysis jobs (--max-jobs)."), "503": err("Worker queue full (see Retry-After) or shutting down."),
      "504": err("The request's deadline passed; the work was cancelled.")}
 def errs(*codes): return {c: E[c] for c in codes}
+def created(schema, links):
+    return {"description": "Created.", "headers": {"Location": {"schema": {"type": "string"}}},
+            "content": {"application/json": {"schema": schema}}, "links": links}
+def link(op, pointer="/id", desc=None, body=None):
+    """An OpenAPI link to operation `op` whose `id` is taken from the answer at `pointer`."""
+    out = {"operationId": op}
+    if pointer is not None:
+        out["parameters"] = {"path.id": f"$response.body#{pointer}"}
+    if body is not None:
+        out["requestBody"] = body
+    if desc:
+        out["description"] = desc
+    return out
+def links_to(ops, pointer="/id", deletes=True):
+    """Links to `ops` with the id at `pointer`; from a list (deletes=False) not to DELETE, so
+    that following links from a listing never removes what others stored."""
+    return {op: link(op, pointer) for op in ops if deletes or not op.startswith("delete_")}
+EXEMPLAR_OPS = ["get_exemplar", "get_exemplar_table", "delete_exemplar"]
+FIELD_OPS = ["get_field", "get_field_file", "sample_frames", "add_curve", "delete_field"]
+VOLUME_OPS = ["get_volume", "volume_stats", "slice", "cut", "region", "points", "surface", "delete_volume"]
+MESH_OPS = ["get_mesh", "get_mesh_file", "delete_mesh"]
 image_out = {"description": "The cut. PNG (8-bit sRGB) by default; with `Accept: application/octet-stream` raw sRGB8 bytes (H x W x 3, row-major) and with `Accept: application/octet-stream; dtype=float32` raw little-endian float32 linear RGB; raw answers carry `X-Shape: H,W,3` and `X-Dtype`.",
     "headers": {"X-Shape": {"schema": {"type": "string"}}, "X-Dtype": {"schema": {"type": "string"}}, "X-Voxels-Synthesized": {"schema": {"type": "integer"}, "description": "Voxels this request synthesized over all levels (0 when everything was cached)."}},
     "content": {"image/png": {"schema": {"type": "string", "format": "binary"}}, "application/octet-stream": {"schema": {"type": "string", "format": "binary"}}}}
 analysis_params = [
-    qp("name", "Free-form label.", {"type": "string"}),
-    qp("levels", "Pyramid levels L.", {"type": "integer", "minimum": 1, "maximum": 8, "default": 4}),
-    qp("neighborhood", "Template size N (odd).", {"type": "integer", "minimum": 3, "maximum": 15, "default": 9}),
-    qp("candidates", "Candidate triples per pixel N_T.", {"type": "integer", "minimum": 1, "maximum": 32, "default": 12}),
-    qp("pca_dims", "Appearance-space dimensions per plane.", {"type": "integer", "minimum": 1, "maximum": 64, "default": 20}),
-    qp("seed", "Seeds the k-NN trees.", {"type": "integer", "minimum": 0, "default": 1}),
-    qp("plane_weights", "Suggested plane weights 'A,B,C' stored with the table.", {"type": "string"}),
-    qp("grain", "'x': the exemplar's stripes run along its x axis and the solid's grain along world x: xy = E, zx = E transposed, yz = E with suggested weight 0.1 (as `solidtex analyze --grain x`).", {"type": "string", "enum": ["x"]}),
-    qp("mask_weight", "Weight of the feature-mask channel relative to color.", {"type": "number", "minimum": 0, "maximum": 10, "default": 1}),
+    qp("name", "Free-form label, at most 200 characters.", {"type": "string", "maxLength": 200}),
+    qp("levels", "Pyramid levels L.", integer(1, 8, default=4)),
+    qp("neighborhood", "Template size N (odd).", {"type": "integer", "enum": [3, 5, 7, 9, 11, 13, 15], "default": 9}),
+    qp("candidates", "Candidate triples per pixel N_T.", integer(1, 32, default=12)),
+    qp("pca_dims", "Appearance-space dimensions per plane.", integer(1, 64, default=20)),
+    qp("seed", "Seeds the k-NN trees.", integer(0, MAX_SEED, default=1)),
+    {**qlist("plane_weights", "Suggested plane weights A,B,C (xy, yz, zx) stored with the table, each in [0, 1], not all 0 (one at least 1e-6).", number(0, 1), 3),
+     "schema": {"type": "array", "items": number(0, 1), "minItems": 3, "maxItems": 3, "contains": {"minimum": 1e-6}}},
+    qp("grain", "'x': the exemplar's stripes run along its x axis and the solid's grain along world x: xy = E, zx = E transposed, yz = E with suggested weight 0.1 (as `solidtex analyze --grain x`); not with yz/zx parts.", {"type": "string", "enum": ["x"]}),
+    qp("mask_weight", "Weight of the feature-mask channel relative to color.", number(0, 10, default=1)),
 ]
+
+
+def bundle(file, names):
+    """The JSON Schema in proto/`file` as components: its root and each of its $defs under the
+    names in `names` ("" names the root); refs to its $defs are rewritten to components."""
+    schema = json.loads((HERE / file).read_text())
+    defs = schema.pop("$defs", {})
+    for k in ("$schema", "$id"):
+        schema.pop(k, None)
+    def rewrite(node):
+        if isinstance(node, dict):
+            return {k: (f"#/components/schemas/{names[v[len('#/$defs/'):]]}" if k == "$ref" and isinstance(v, str) and v.startswith("#/$defs/") else rewrite(v))
+                    for k, v in node.items()}
+        if isinstance(node, list):
+            return [rewrite(v) for v in node]
+        return node
+    out = {names[""]: rewrite(schema)}
+    for k, v in defs.items():
+        out[names[k]] = rewrite(v)
+    return out
+
+
+nullable_error = {"description": "null unless failed: {code, message, field} as in Error.", "oneOf": [{"type": "null"}, ref("ErrorDetail")]}
 S = {
- "Error": {"type": "object", "required": ["error"], "properties": {"error": {"type": "object", "required": ["code", "message", "field"], "properties": {
+ "Error": {"type": "object", "required": ["error"], "properties": {"error": ref("ErrorDetail")}},
+ "ErrorDetail": {"type": "object", "required": ["code", "message", "field"], "properties": {
      "code": {"type": "string", "description": "Machine-readable: invalid_argument, not_found, unsupported, too_large, corrupt, unprocessable, version_mismatch, cancelled, deadline_exceeded, resource_exhausted, rate_limited, already_exists, failed_precondition, method_not_allowed, internal, io."},
-     "message": {"type": "string"}, "field": {"type": "string", "description": "The input the error is about (body, a JSON path, a query parameter); may be empty."}}}}},
+     "message": {"type": "string"}, "field": {"type": "string", "description": "The input the error is about (body, a JSON path, a query parameter); may be empty."}}},
  "Job": {"type": "object", "required": ["id", "kind", "state", "percent"], "properties": {
      "id": {"type": "string"}, "kind": {"type": "string", "enum": ["analysis"]}, "exemplar_id": {"type": "string"},
      "state": {"type": "string", "enum": ["queued", "running", "succeeded", "failed"]},
      "percent": {"type": "number", "minimum": 0, "maximum": 100}, "seconds": {"type": "number"},
-     "error": {"description": "null unless failed", "oneOf": [{"type": "null"}, {"type": "object"}]}}},
+     "error": nullable_error}},
  "LevelReport": {"type": "object", "properties": {"level": {"type": "integer"}, "spacing": {"type": "integer"}, "mean_crossbar_error": {"type": "number"}, "random_crossbar_error": {"type": "number"}, "coherent_fraction": {"type": "number"}}},
  "Exemplar": {"type": "object", "required": ["id", "state"], "properties": {
      "id": {"type": "string"}, "name": {"type": "string"}, "state": {"type": "string", "enum": ["analyzing", "ready", "failed"]},
      "job_id": {"type": "string"}, "grain": {"type": "string"}, "seconds": {"type": "number"}, "planes": {"type": "integer", "enum": [1, 3]}, "has_mask": {"type": "boolean"},
      "width": {"type": "integer"}, "height": {"type": "integer"}, "params": {"type": "object"},
      "levels": {"type": "array", "items": ref("LevelReport")}, "table_bytes": {"type": "integer"},
-     "error": {"oneOf": [{"type": "null"}, {"type": "object"}]}}},
+     "error": nullable_error}},
  "ExemplarCreated": {"type": "object", "required": ["exemplar", "job"], "properties": {"exemplar": ref("Exemplar"), "job": ref("Job")}},
  "Field": {"type": "object", "required": ["id", "revision"], "properties": {
      "id": {"type": "string"}, "revision": {"type": "integer", "description": "1 at creation, +1 per added curve."},
@@ -64,133 +145,151 @@ S = {
      "field": {"type": "object", "description": "Where the field came from: {\"kind\": \"identity\"}, {\"kind\": \"spec\", \"spec\"} or {\"kind\": \"stored\", \"id\", \"revision\"} (the volume keeps its own copy of that revision).", "properties": {"kind": {"type": "string", "enum": ["identity", "spec", "stored"]}, "spec": {"type": "string"}, "id": {"type": "string"}, "revision": {"type": "integer"}}},
      "field_description": {"type": "string", "description": "Human-readable description of the field, e.g. 'identity' or 'quat:0.92,0,0,0.38'."},
      "seed": {"type": "integer"}, "params": {"type": "object"}}},
- "Cut": {"type": "object", "additionalProperties": False, "required": ["origin", "u", "v", "size"], "properties": {
-     "origin": {"type": "array", "items": {"type": "number"}, "minItems": 3, "maxItems": 3, "description": "World units (finest voxels)."},
-     "u": {"type": "array", "items": {"type": "number"}, "minItems": 3, "maxItems": 3, "description": "Step per output column, voxel units."},
-     "v": {"type": "array", "items": {"type": "number"}, "minItems": 3, "maxItems": 3, "description": "Step per output row, voxel units."},
-     "size": {"type": "array", "items": {"type": "integer"}, "minItems": 2, "maxItems": 2, "description": "W, H."}}},
+ "Cut": {"type": "object", "additionalProperties": False, "required": ["origin", "u", "v", "size"],
+     "description": f"The far corner origin + W*u + H*v must lie within +-2^28 too (else 400); W*H at most --max-voxels (else 422).",
+     "properties": {
+     "origin": {**vec3, "description": "World units (finest voxels)."},
+     "u": {**vec3, "description": "Step per output column, voxel units."},
+     "v": {**vec3, "description": "Step per output row, voxel units."},
+     "size": {"type": "array", "items": integer(1, MAX_CUT_SIDE), "minItems": 2, "maxItems": 2, "description": "W, H."}}},
+ "PointsRequest": {"type": "object", "additionalProperties": False, "required": ["points"], "properties": {
+     "points": {"type": "array", "minItems": 1, "items": vec3, "description": "World points; at most --max-voxels of them (else 422)."}}},
  "Mesh": {"type": "object", "required": ["id"], "properties": {
      "id": {"type": "string"}, "name": {"type": "string"}, "format": {"type": "string", "enum": ["ply", "obj", "off"]},
      "vertices": {"type": "integer", "description": "Every vertex position of the file, unreferenced ones included (they get colors too); OBJ texture coordinates and normals are ignored."}, "triangles": {"type": "integer", "description": "After fan triangulation of polygons and removal of duplicate and degenerate faces."},
      "bounds": {"type": "object", "properties": {"min": {"type": "array", "items": {"type": "number"}}, "max": {"type": "array", "items": {"type": "number"}}}},
      "defects": {"type": "object", "description": "What the reader tolerated: duplicate_faces and degenerate_faces (dropped), unreferenced_vertices, boundary_edges (holes), non_manifold_edges, components.",
                  "properties": {k: {"type": "integer"} for k in ["duplicate_faces", "degenerate_faces", "unreferenced_vertices", "boundary_edges", "non_manifold_edges", "components", "polygons_triangulated"]}}}},
- "Placement": {"type": "object", "additionalProperties": False, "description": "Mesh coordinates to world (finest-voxel) coordinates: world = scale * mesh + translate. Omitted: fit the mesh's bounding box, enlarged by `margin` on every side, to `resolution` voxels along its longest side, with the box's minimum corner at the origin.",
-     "properties": {"resolution": {"type": "integer", "minimum": 8, "maximum": 4096, "default": 512}, "margin": {"type": "number", "minimum": 0, "maximum": 1, "default": 0.25, "description": "Fraction of the longest side added on every side (the paper enlarges by 20-30%)."},
-                    "scale": {"type": "number", "exclusiveMinimum": 0}, "translate": {"type": "array", "items": {"type": "number"}, "minItems": 3, "maxItems": 3}}},
  "SurfaceRequest": {"type": "object", "additionalProperties": False, "required": ["mesh"], "properties": {
-     "mesh": {"type": "string", "description": "Id of a stored mesh."},
+     "mesh": {"type": "string", "maxLength": ID_MAX, "description": "Id of a stored mesh."},
      "placement": ref("Placement"),
      "format": {"type": "string", "enum": ["ply", "json"], "default": "ply"},
-     "points": {"type": "array", "description": "Extra surface points (mesh coordinates) to color as well (JSON format only).", "items": {"type": "array", "items": {"type": "number"}, "minItems": 3, "maxItems": 3}}}},
+     "points": {"type": "array", "description": "Extra surface points (mesh coordinates) to color as well (format json only).", "items": {"type": "array", "items": {"type": "number"}, "minItems": 3, "maxItems": 3}}},
+     "if": {"required": ["points"]}, "then": {"required": ["format"], "properties": {"format": {"const": "json"}}}},
  "SurfaceColors": {"type": "object", "properties": {
      "vertices": {"type": "integer"}, "colors": {"type": "array", "description": "Linear RGB per vertex (float).", "items": {"type": "array", "items": {"type": "number"}}},
      "point_colors": {"type": "array", "items": {"type": "array", "items": {"type": "number"}}},
      "placement": {"type": "object", "properties": {"scale": {"type": "number"}, "translate": {"type": "array", "items": {"type": "number"}}}},
      "stats": {"type": "object", "description": "target_voxels (distinct finest voxels the surface needs), bounding_voxels (voxels of the placed mesh's bounding box), fraction (synthesized voxels over all levels / bounding_voxels), voxels_synthesized, levels (per-level dependent-set sizes)."}}},
  "FieldFromMesh": {"type": "object", "additionalProperties": False, "required": ["mesh", "kind"], "properties": {
-     "mesh": {"type": "string"}, "kind": {"type": "string", "enum": ["curvature", "features"], "description": "curvature: principal-curvature frames at surface vertices (Gorla et al.), x along the direction of least curvature, y along the normal; features: crest lines (edges whose dihedral angle exceeds feature_angle_degrees, chained) and any user `curves`, used as sketch curves with x along the curve."},
+     "mesh": {"type": "string", "maxLength": ID_MAX}, "kind": {"type": "string", "enum": ["curvature", "features"], "description": "curvature: principal-curvature frames at surface vertices (Gorla et al.), x along the direction of least curvature, y along the normal; features: crest lines (edges whose dihedral angle exceeds feature_angle_degrees, chained) and any user `curves`, used as sketch curves with x along the curve."},
      "placement": ref("Placement"),
-     "shortest_side_cells": {"type": "integer", "minimum": 2, "maximum": 256, "default": 24},
-     "max_constraints": {"type": "integer", "minimum": 1, "maximum": 20000, "default": 2000, "description": "curvature: at most this many vertex frames: one per occupied cube of the field's grid spacing (the cube grows by 25% until the budget holds), so usually fewer."},
-     "feature_angle_degrees": {"type": "number", "minimum": 1, "maximum": 179, "default": 60},
+     "shortest_side_cells": integer(2, 256, default=24),
+     "max_constraints": integer(1, 20000, default=2000, description="curvature: at most this many vertex frames: one per occupied cube of the field's grid spacing (the cube grows by 25% until the budget holds), so usually fewer."),
+     "feature_angle_degrees": number(1, 179, default=60),
      "curves": {"type": "array", "description": "features: user polylines on the surface (mesh coordinates); normals are taken from the nearest vertices.", "items": {"type": "array", "items": {"type": "array", "items": {"type": "number"}, "minItems": 3, "maxItems": 3}}}}},
  "Stats": {"type": "object", "properties": {"volume": {"type": "string"}, "levels": {"type": "array", "items": {"type": "object", "properties": {"level": {"type": "integer"}, "voxels_synthesized": {"type": "integer"}, "cached_voxels": {"type": "integer"}}}},
      "cache": {"type": "object", "properties": {"bytes": {"type": "integer"}, "budget_bytes": {"type": "integer"}, "hits": {"type": "integer"}, "misses": {"type": "integer"}, "bricks": {"type": "integer"}, "evicted_bricks": {"type": "integer"}}},
      "requests": {"type": "integer"}, "recent": {"type": "array", "description": "The last requests (newest last): kind, target voxels and dependent-set sizes per level.", "items": {"type": "object"}}}},
+ **bundle("sketch.schema.json", {"": "Sketch", "vec3": "SketchVec3", "curve": "SketchCurve", "scalePoint": "SketchScalePoint", "frame": "SketchFrame"}),
+ **bundle("volume.schema.json", {"": "VolumeSpec", "synthesisParams": "SynthesisParams", "placement": "Placement"}),
 }
+
+MESH_EXAMPLE = "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n"
+exemplar_links = {**links_to(EXEMPLAR_OPS, "/exemplar/id"), "get_job": link("get_job", "/job/id")}
 paths = {
- "/healthz": {"get": {"operationId": "healthz", "summary": "Liveness.", "responses": {"200": js({"type": "object"})}}},
+ "/healthz": {"get": {"operationId": "healthz", "summary": "Liveness.", "responses": {"200": js({"type": "object", "required": ["status"], "properties": {"status": {"type": "string", "enum": ["ok", "stopping"]}, "queue_depth": {"type": "integer"}, "workers_busy": {"type": "integer"}}}), **errs("400")}}},
  "/metrics": {"get": {"operationId": "metrics", "summary": "Prometheus text: requests and latency histograms per route, voxels synthesized, cache bytes, queue depth.", "responses": {"200": {"description": "OK", "content": {"text/plain": {"schema": {"type": "string"}}}}}}},
  "/v1/openapi.json": {"get": {"operationId": "openapi", "summary": "This document.", "responses": {"200": js({"type": "object"})}}},
  "/v1/exemplars": {
-   "get": {"operationId": "list_exemplars", "summary": "List exemplars.", "responses": {"200": js({"type": "object", "properties": {"exemplars": {"type": "array", "items": ref("Exemplar")}}})}},
+   "get": {"operationId": "list_exemplars", "summary": "List exemplars.", "responses": {"200": {**js({"type": "object", "properties": {"exemplars": {"type": "array", "items": ref("Exemplar")}}}),
+       "links": {**links_to(EXEMPLAR_OPS, "/exemplars/0/id", deletes=False), "create_volume": link("create_volume", None, "A volume of the first exemplar.", {"exemplar": "$response.body#/exemplars/0/id"})}}, **errs("400")}},
    "post": {"operationId": "upload_exemplar", "summary": "Upload an exemplar; its analysis runs in the background.",
-     "description": "Body: the image bytes (any Content-Type but multipart/form-data and application/json), or multipart/form-data with parts `xy` (or `image`), optional `yz` and `zx` (all three or only one), and optional `mask` (with three planes also `mask_yz` and `mask_zx`). PNG, JPEG, TIFF, OpenEXR; gray/RGB/RGBA, 8/16-bit or float. Analysis parameters in the query. The upload is stored before the answer, so an acknowledged upload survives a restart (its analysis is re-run).",
+     "description": "Body: the image bytes (any Content-Type but multipart/form-data, application/json and application/x-www-form-urlencoded), or multipart/form-data with parts `xy` (or `image`), optional `yz` and `zx` (all three or only one), and optional `mask` (with three planes also `mask_yz` and `mask_zx`); at most 16 parts. PNG, JPEG, TIFF, OpenEXR, recognised from the bytes (else 415); gray/RGB/RGBA, 8/16-bit or float; at least 8 and at most --max-image-side (8192) pixels per side and --max-image-pixels in all (else 422, checked from the header); analysing it must fit --max-request-mb (else 422). Analysis parameters in the query. The upload is stored before the answer, so an acknowledged upload survives a restart (its analysis is re-run).",
      "parameters": analysis_params,
-     "requestBody": {"required": True, "content": {"application/octet-stream": {"schema": {"type": "string", "format": "binary"}}, "multipart/form-data": {"schema": {"type": "object", "properties": {"xy": {"type": "string", "format": "binary"}, "yz": {"type": "string", "format": "binary"}, "zx": {"type": "string", "format": "binary"}, "mask": {"type": "string", "format": "binary"}, "mask_yz": {"type": "string", "format": "binary"}, "mask_zx": {"type": "string", "format": "binary"}}}}}},
-     "responses": {"202": {"description": "Accepted; poll the job.", "headers": {"Location": {"schema": {"type": "string"}}}, "content": {"application/json": {"schema": ref("ExemplarCreated")}}}, **errs("400", "413", "415", "422", "429", "503")}}},
+     "requestBody": {"required": True, "content": {"application/octet-stream": {"schema": {"type": "string", "format": "binary", "minLength": 1}}, "multipart/form-data": {"schema": {"type": "object", "required": ["xy"], "additionalProperties": False, "properties": {"xy": {"type": "string", "format": "binary"}, "yz": {"type": "string", "format": "binary"}, "zx": {"type": "string", "format": "binary"}, "mask": {"type": "string", "format": "binary"}, "mask_yz": {"type": "string", "format": "binary"}, "mask_zx": {"type": "string", "format": "binary"}}}}}},
+     "responses": {"202": {"description": "Accepted; poll the job.", "headers": {"Location": {"schema": {"type": "string"}}}, "content": {"application/json": {"schema": ref("ExemplarCreated")}}, "links": exemplar_links}, **errs("400", "413", "415", "422", "429", "503")}}},
  "/v1/exemplars/{id}": {"parameters": [pid()],
-   "get": {"operationId": "get_exemplar", "summary": "One exemplar.", "responses": {"200": js(ref("Exemplar")), **errs("404")}},
-   "delete": {"operationId": "delete_exemplar", "summary": "Delete an exemplar not used by any volume.", "responses": {"204": {"description": "Deleted."}, "409": err("A volume uses it, or its analysis is still running."), **errs("404")}}},
+   "get": {"operationId": "get_exemplar", "summary": "One exemplar.", "responses": {"200": {**js(ref("Exemplar")), "links": {"create_volume": link("create_volume", None, "A volume of this exemplar.", {"exemplar": "$response.body#/id"})}}, **errs("404")}},
+   "delete": {"operationId": "delete_exemplar", "summary": "Delete an exemplar not used by any volume.", "responses": {"204": {"description": "Deleted."}, "409": err("A volume uses it."), **errs("404", "503")}}},
  "/v1/exemplars/{id}/table": {"parameters": [pid()],
-   "get": {"operationId": "get_exemplar_table", "summary": "The .stx candidate-triple table (the same bytes `solidtex analyze` writes for the same inputs).", "responses": {"200": {"description": "OK", "content": {"application/octet-stream": {"schema": {"type": "string", "format": "binary"}}}}, "409": err("Not ready."), **errs("404")}}},
+   "get": {"operationId": "get_exemplar_table", "summary": "The .stx candidate-triple table (the same bytes `solidtex analyze` writes for the same inputs).", "responses": {"200": {"description": "OK", "content": {"application/octet-stream": {"schema": {"type": "string", "format": "binary"}}}}, "409": err("Not ready."), **errs("404", "503")}}},
  "/v1/jobs/{id}": {"parameters": [pid()],
    "get": {"operationId": "get_job", "summary": "State and progress of a background job.", "responses": {"200": js(ref("Job")), **errs("404")}}},
  "/v1/fields": {
-   "get": {"operationId": "list_fields", "summary": "List fields.", "responses": {"200": js({"type": "object", "properties": {"fields": {"type": "array", "items": ref("Field")}}})}},
-   "post": {"operationId": "create_field", "summary": "Solve a frame field from a sketch (schema: sketch.schema.json).", "parameters": [timeout],
-     "requestBody": {"required": True, "content": {"application/json": {"schema": {"$ref": "sketch.schema.json"}}}},
-     "responses": {"201": {"description": "Created.", "headers": {"Location": {"schema": {"type": "string"}}}, "content": {"application/json": {"schema": ref("Field")}}}, **errs("400", "413", "415", "422", "503", "504")}}},
+   "get": {"operationId": "list_fields", "summary": "List fields.", "responses": {"200": {**js({"type": "object", "properties": {"fields": {"type": "array", "items": ref("Field")}}}), "links": links_to(FIELD_OPS, "/fields/0/id", deletes=False)}, **errs("400")}},
+   "post": {"operationId": "create_field", "summary": "Solve a frame field from a sketch (schema: Sketch, from proto/sketch.schema.json). Rules between fields (points inside the domain, consecutive points distinct, one normal per point, frames defined along the curve, non-zero quaternions) are checked too (400); a grid above --max-field-nodes is refused (422).", "parameters": [timeout],
+     "requestBody": {"required": True, "content": {"application/json": {"schema": ref("Sketch")}}},
+     "responses": {"201": created(ref("Field"), links_to(FIELD_OPS)), **errs("400", "413", "415", "422", "503", "504")}}},
  "/v1/fields/{id}": {"parameters": [pid()],
    "get": {"operationId": "get_field", "summary": "One field.", "responses": {"200": js(ref("Field")), **errs("404")}},
-   "delete": {"operationId": "delete_field", "summary": "Delete a field (volumes keep their own copies).", "responses": {"204": {"description": "Deleted."}, **errs("404")}}},
+   "delete": {"operationId": "delete_field", "summary": "Delete a field (volumes keep their own copies).", "responses": {"204": {"description": "Deleted."}, **errs("404", "503")}}},
  "/v1/fields/{id}/file": {"parameters": [pid()],
-   "get": {"operationId": "get_field_file", "summary": "The .stf field file of the current revision (usable with `solidtex slice --field`).", "responses": {"200": {"description": "OK", "content": {"application/octet-stream": {"schema": {"type": "string", "format": "binary"}}}}, **errs("404")}}},
+   "get": {"operationId": "get_field_file", "summary": "The .stf field file of the current revision (usable with `solidtex slice --field`).", "responses": {"200": {"description": "OK", "content": {"application/octet-stream": {"schema": {"type": "string", "format": "binary"}}}}, **errs("404", "503")}}},
  "/v1/fields/{id}/curves": {"parameters": [pid()],
-   "post": {"operationId": "add_curve", "summary": "Add one curve (a sketch curve object) and re-solve incrementally; the revision increases.", "parameters": [timeout],
-     "requestBody": {"required": True, "content": {"application/json": {"schema": {"$ref": "sketch.schema.json#/$defs/curve"}}}},
-     "responses": {"200": js(ref("Field")), **errs("400", "404", "413", "415", "503", "504")}}},
+   "post": {"operationId": "add_curve", "summary": "Add one curve (a sketch curve object, schema SketchCurve) and re-solve incrementally; the revision increases. The curve must lie inside the field's domain (400).", "parameters": [timeout],
+     "requestBody": {"required": True, "content": {"application/json": {"schema": ref("SketchCurve")}}},
+     "responses": {"200": js(ref("Field")), **errs("400", "404", "413", "415", "422", "503", "504")}}},
  "/v1/fields/{id}/frames": {"parameters": [pid()],
    "get": {"operationId": "sample_frames", "summary": "Frames on a regular grid of points, for display.",
-     "parameters": [qp("min", "X,Y,Z world units.", required=True), qp("size", "Points per axis NX,NY,NZ (product <= 65536).", required=True), qp("step", "World units between points (default 1).", {"type": "number"})],
-     "responses": {"200": js(ref("Frames")), **errs("400", "404", "422")}}},
+     "parameters": [qlist("min", "X,Y,Z world units of the first point.", {"type": "number"}, 3, True),
+                    qlist("size", "Points per axis NX,NY,NZ; their product at most 65536 (else 422).", integer(1, 65536), 3, True),
+                    qp("step", "World units between points.", {"type": "number", "exclusiveMinimum": 0, "maximum": 1e6, "default": 1})],
+     "responses": {"200": js(ref("Frames")), **errs("400", "404", "422", "503")}}},
  "/v1/volumes": {
-   "get": {"operationId": "list_volumes", "summary": "List volumes.", "responses": {"200": js({"type": "object", "properties": {"volumes": {"type": "array", "items": ref("Volume")}}})}},
-   "post": {"operationId": "create_volume", "summary": "Create a volume from ready exemplars, a field and synthesis parameters (schema: volume.schema.json).",
-     "requestBody": {"required": True, "content": {"application/json": {"schema": {"$ref": "volume.schema.json"}}}},
-     "responses": {"201": {"description": "Created.", "headers": {"Location": {"schema": {"type": "string"}}}, "content": {"application/json": {"schema": ref("Volume")}}}, "409": err("An exemplar is not ready."), **errs("400", "404", "413", "415")}}},
+   "get": {"operationId": "list_volumes", "summary": "List volumes.", "responses": {"200": {**js({"type": "object", "properties": {"volumes": {"type": "array", "items": ref("Volume")}}}), "links": links_to(VOLUME_OPS, "/volumes/0/id", deletes=False)}, **errs("400")}},
+   "post": {"operationId": "create_volume", "summary": "Create a volume from ready exemplars, a field and synthesis parameters (schema: VolumeSpec, from proto/volume.schema.json). The exemplars must exist (404) and be ready (409), a stored field must exist (404); label and field spec values are checked (400).",
+     "requestBody": {"required": True, "content": {"application/json": {"schema": ref("VolumeSpec")}}},
+     "responses": {"201": created(ref("Volume"), links_to(VOLUME_OPS)), "409": err("An exemplar is not ready."), **errs("400", "404", "413", "415", "422", "503")}}},
  "/v1/volumes/{id}": {"parameters": [pid()],
    "get": {"operationId": "get_volume", "summary": "One volume.", "responses": {"200": js(ref("Volume")), **errs("404")}},
-   "delete": {"operationId": "delete_volume", "summary": "Delete a volume and drop its cache.", "responses": {"204": {"description": "Deleted."}, **errs("404")}}},
+   "delete": {"operationId": "delete_volume", "summary": "Delete a volume and drop its cache.", "responses": {"204": {"description": "Deleted."}, **errs("404", "503")}}},
  "/v1/volumes/{id}/slice": {"parameters": [pid()],
-   "get": {"operationId": "slice", "summary": "Axis-aligned cut: pixel (i, j) is finest voxel (u0+i, v0+j, at) for axis z, (at, u0+i, v0+j) for x, (u0+i, at, v0+j) for y.",
-     "parameters": [qp("axis", "x, y or z.", {"type": "string", "enum": ["x", "y", "z"]}, True), qp("at", "Voxel index along the axis.", {"type": "integer"}, True),
-                    qp("origin", "U,V (default 0,0).", {"type": "string"}), qp("size", "W,H.", {"type": "string"}, True), timeout],
+   "get": {"operationId": "slice", "summary": "Axis-aligned cut: pixel (i, j) is finest voxel (u0+i, v0+j, at) for axis z, (at, u0+i, v0+j) for x, (u0+i, at, v0+j) for y. W*H at most --max-voxels (else 422).",
+     "parameters": [qp("axis", "x, y or z.", {"type": "string", "enum": ["x", "y", "z"]}, True), qp("at", "Voxel index along the axis.", integer(-MAX_COORD, MAX_COORD), True),
+                    qlist("origin", "U,V (default 0,0), each in [-2^28, 2^28 - 2^24].", integer(-MAX_COORD, MAX_ORIGIN), 2),
+                    qlist("size", "W,H, each in [1, 2^24].", integer(1, MAX_SIDE), 2, True), timeout],
      "responses": {"200": image_out, **errs("400", "404", "422", "503", "504")}}},
  "/v1/volumes/{id}/cut": {"parameters": [pid()],
    "post": {"operationId": "cut", "summary": "Arbitrary planar cut: pixel (i, j) is the voxel nearest origin + i*u + j*v.", "parameters": [timeout],
      "requestBody": {"required": True, "content": {"application/json": {"schema": ref("Cut")}}},
      "responses": {"200": image_out, **errs("400", "404", "413", "415", "422", "503", "504")}}},
  "/v1/volumes/{id}/region": {"parameters": [pid()],
-   "get": {"operationId": "region", "summary": "A box of voxels. Default: an OpenVDB file with one Vec3s grid 'color' (linear RGB, index space = finest voxels). `Accept: application/octet-stream` gives raw sRGB8 (D x H x W x 3, x fastest), `; dtype=float32` raw linear float32.",
-     "parameters": [qp("min", "X,Y,Z voxel indices.", {"type": "string"}, True), qp("size", "W,H,D voxels.", {"type": "string"}, True), timeout],
-     "responses": {"200": {"description": "The voxels.", "headers": {"X-Shape": {"schema": {"type": "string"}}, "X-Dtype": {"schema": {"type": "string"}}},
+   "get": {"operationId": "region", "summary": "A box of voxels; W*H*D at most --max-voxels (else 422). Default: an OpenVDB file with one Vec3s grid 'color' (linear RGB, index space = finest voxels). `Accept: application/octet-stream` gives raw sRGB8 (D x H x W x 3, x fastest), `; dtype=float32` raw linear float32.",
+     "parameters": [qlist("min", "X,Y,Z voxel indices, each in [-2^28, 2^28 - 2^24].", integer(-MAX_COORD, MAX_ORIGIN), 3, True),
+                    qlist("size", "W,H,D voxels, each in [1, 2^24].", integer(1, MAX_SIDE), 3, True), timeout],
+     "responses": {"200": {"description": "The voxels.", "headers": {"X-Shape": {"schema": {"type": "string"}}, "X-Dtype": {"schema": {"type": "string"}}, "X-Voxels-Synthesized": {"schema": {"type": "integer"}}},
                             "content": {"application/x-vdb": {"schema": {"type": "string", "format": "binary"}}, "application/octet-stream": {"schema": {"type": "string", "format": "binary"}}}}, **errs("400", "404", "422", "503", "504")}}},
  "/v1/volumes/{id}/points": {"parameters": [pid()],
-   "post": {"operationId": "points", "summary": "Colors at world points (each rounded to its nearest finest voxel).", "parameters": [timeout],
-     "requestBody": {"required": True, "content": {"application/octet-stream": {"schema": {"type": "string", "format": "binary", "description": "Little-endian float32 x,y,z per point."}}, "application/json": {"schema": {"type": "object", "additionalProperties": False, "required": ["points"], "properties": {"points": {"type": "array", "items": {"type": "array", "items": {"type": "number"}, "minItems": 3, "maxItems": 3}}}}}}},
+   "post": {"operationId": "points", "summary": "Colors at world points (each rounded to its nearest finest voxel); at most --max-voxels points (else 422).", "parameters": [timeout],
+     "requestBody": {"required": True, "content": {"application/octet-stream": {"schema": {"type": "string", "format": "binary", "minLength": 12, "description": "Little-endian float32 x,y,z per point: a non-empty multiple of 12 bytes, finite, within +-2^28 (else 400)."}}, "application/json": {"schema": ref("PointsRequest")}}},
      "responses": {"200": {"description": "Linear RGB per point: raw little-endian float32 (N x 3, `X-Shape: N,3`) by default, or JSON {\"rgb\": [[r,g,b], ...]} with `Accept: application/json`.",
-                            "content": {"application/octet-stream": {"schema": {"type": "string", "format": "binary"}}, "application/json": {"schema": {"type": "object", "properties": {"rgb": {"type": "array"}}}}}}, **errs("400", "404", "413", "415", "422", "503", "504")}}},
+                            "headers": {"X-Shape": {"schema": {"type": "string"}}, "X-Dtype": {"schema": {"type": "string"}}, "X-Voxels-Synthesized": {"schema": {"type": "integer"}}},
+                            "content": {"application/octet-stream": {"schema": {"type": "string", "format": "binary"}}, "application/json": {"schema": {"type": "object", "properties": {"rgb": {"type": "array", "items": {"type": "array", "items": {"type": "number"}}}}}}}}, **errs("400", "404", "413", "415", "422", "503", "504")}}},
  "/v1/meshes": {
-   "get": {"operationId": "list_meshes", "summary": "List meshes.", "responses": {"200": js({"type": "object", "properties": {"meshes": {"type": "array", "items": ref("Mesh")}}})}},
-   "post": {"operationId": "upload_mesh", "summary": "Store a mesh: OBJ, PLY (ASCII or binary) or OFF, detected from the bytes; polygons are fan-triangulated; defects (duplicate faces, holes, non-manifold edges, several components, unreferenced vertices) are tolerated and reported.",
-     "parameters": [qp("name", "Free-form label.")], "requestBody": {"required": True, "content": {"application/octet-stream": {"schema": {"type": "string", "format": "binary"}}}},
-     "responses": {"201": {"description": "Created.", "headers": {"Location": {"schema": {"type": "string"}}}, "content": {"application/json": {"schema": ref("Mesh")}}}, **errs("400", "413", "415", "422", "503")}}},
+   "get": {"operationId": "list_meshes", "summary": "List meshes.", "responses": {"200": {**js({"type": "object", "properties": {"meshes": {"type": "array", "items": ref("Mesh")}}}), "links": links_to(MESH_OPS, "/meshes/0/id", deletes=False)}, **errs("400")}},
+   "post": {"operationId": "upload_mesh", "summary": "Store a mesh: OBJ, PLY (ASCII or binary) or OFF, detected from the bytes (else 415); polygons are fan-triangulated; defects (duplicate faces, holes, non-manifold edges, several components, unreferenced vertices) are tolerated and reported. A mesh without a usable triangle, or with out-of-range indices, is refused (422), as is one above --max-mesh-vertices / --max-mesh-faces.",
+     "parameters": [qp("name", "Free-form label, at most 200 characters.", {"type": "string", "maxLength": 200})],
+     "requestBody": {"required": True, "content": {"application/octet-stream": {"schema": {"type": "string", "format": "binary", "minLength": 1}, "example": MESH_EXAMPLE}}},
+     "responses": {"201": created(ref("Mesh"), {**links_to(MESH_OPS),
+                                                "field_from_mesh": link("field_from_mesh", None, "A curvature field of this mesh.", {"mesh": "$response.body#/id", "kind": "curvature"})}),
+                   **errs("400", "413", "415", "422", "503")}}},
  "/v1/meshes/{id}": {"parameters": [pid()],
    "get": {"operationId": "get_mesh", "summary": "One mesh (summary and defects).", "responses": {"200": js(ref("Mesh")), **errs("404")}},
-   "delete": {"operationId": "delete_mesh", "summary": "Delete a mesh.", "responses": {"204": {"description": "Deleted."}, **errs("404")}}},
+   "delete": {"operationId": "delete_mesh", "summary": "Delete a mesh.", "responses": {"204": {"description": "Deleted."}, **errs("404", "503")}}},
  "/v1/meshes/{id}/file": {"parameters": [pid()],
-   "get": {"operationId": "get_mesh_file", "summary": "The mesh as stored: binary little-endian PLY of the cleaned triangles (positions in mesh coordinates).", "responses": {"200": {"description": "OK", "content": {"application/octet-stream": {"schema": {"type": "string", "format": "binary"}}}}, **errs("404")}}},
+   "get": {"operationId": "get_mesh_file", "summary": "The mesh as stored: binary little-endian PLY of the cleaned triangles (positions in mesh coordinates).", "responses": {"200": {"description": "OK", "content": {"application/octet-stream": {"schema": {"type": "string", "format": "binary"}}}}, **errs("404", "503")}}},
  "/v1/volumes/{id}/surface": {"parameters": [pid()],
    "post": {"operationId": "surface", "summary": "Texture a mesh: synthesize only the voxels its vertices need (each vertex takes the color of its nearest finest voxel, exactly what `points` answers at the placed vertex) and return the colored mesh.",
-     "description": "Body: a SurfaceRequest (application/json) naming a stored mesh, or the mesh bytes themselves (any other Content-Type) with `resolution`, `margin` and `format` in the query. PLY answers are binary little-endian with float x,y,z (mesh coordinates), uchar red, green, blue (sRGB8) per vertex and the triangles; headers X-Target-Voxels, X-Bounding-Voxels, X-Voxels-Synthesized.",
-     "parameters": [timeout, qp("resolution", "With a mesh body: voxels along the longest side.", {"type": "integer"}), qp("margin", "With a mesh body.", {"type": "number"}), qp("format", "With a mesh body: ply or json.", {"type": "string"})],
-     "requestBody": {"required": True, "content": {"application/json": {"schema": ref("SurfaceRequest")}, "application/octet-stream": {"schema": {"type": "string", "format": "binary"}}}},
-     "responses": {"200": {"description": "The colored mesh.", "content": {"application/x-ply": {"schema": {"type": "string", "format": "binary"}}, "application/json": {"schema": ref("SurfaceColors")}}}, **errs("400", "404", "413", "415", "422", "503", "504")}}},
+     "description": "Body: a SurfaceRequest (application/json) naming a stored mesh, or the mesh bytes themselves (any other Content-Type) with `resolution`, `margin` and `format` in the query (with a JSON body they are not accepted: 400). Vertices and extra points together at most --max-voxels (else 422). PLY answers are binary little-endian with float x,y,z (mesh coordinates), uchar red, green, blue (sRGB8) per vertex and the triangles; headers X-Target-Voxels, X-Bounding-Voxels, X-Voxels-Synthesized.",
+     "parameters": [timeout, qp("resolution", "With a mesh body: voxels along the longest side.", integer(8, 4096, default=512)), qp("margin", "With a mesh body: fraction of the longest side added on every side.", number(0, 1, default=0.25)),
+                    qp("format", "With a mesh body: ply or json.", {"type": "string", "enum": ["ply", "json"], "default": "ply"})],
+     "requestBody": {"required": True, "content": {"application/json": {"schema": ref("SurfaceRequest")}, "application/octet-stream": {"schema": {"type": "string", "format": "binary", "minLength": 1}, "example": MESH_EXAMPLE}}},
+     "responses": {"200": {"description": "The colored mesh.", "headers": {"X-Target-Voxels": {"schema": {"type": "integer"}}, "X-Bounding-Voxels": {"schema": {"type": "integer"}}, "X-Voxels-Synthesized": {"schema": {"type": "integer"}}},
+                           "content": {"application/x-ply": {"schema": {"type": "string", "format": "binary"}}, "application/json": {"schema": ref("SurfaceColors")}}}, **errs("400", "404", "413", "415", "422", "503", "504")}}},
  "/v1/fields/from-mesh": {
-   "post": {"operationId": "field_from_mesh", "summary": "Solve a frame field from a stored mesh's geometry: principal-curvature frames or crest-line curves as soft constraints (harmonic interpolation, like sketches). The field's domain is the placed mesh's box (world units), so a volume using it should place the mesh the same way.", "parameters": [timeout],
+   "post": {"operationId": "field_from_mesh", "summary": "Solve a frame field from a stored mesh's geometry: principal-curvature frames or crest-line curves as soft constraints (harmonic interpolation, like sketches). The field's domain is the placed mesh's box (world units), so a volume using it should place the mesh the same way. A mesh without usable feature curves is refused (422).", "parameters": [timeout],
      "requestBody": {"required": True, "content": {"application/json": {"schema": ref("FieldFromMesh")}}},
-     "responses": {"201": {"description": "Created.", "headers": {"Location": {"schema": {"type": "string"}}}, "content": {"application/json": {"schema": ref("Field")}}}, **errs("400", "404", "415", "422", "503", "504")}}},
+     "responses": {"201": created(ref("Field"), links_to(FIELD_OPS)), **errs("400", "404", "413", "415", "422", "503", "504")}}},
  "/v1/volumes/{id}/stats": {"parameters": [pid()],
    "get": {"operationId": "volume_stats", "summary": "Voxels per level, cache bytes and hits, the last requests' dependent-set sizes.", "responses": {"200": js(ref("Stats")), **errs("404")}}},
 }
-doc = {"openapi": "3.0.3", "info": {"title": "solidtex", "version": "1.0.0", "description": "Lazy solid-texture volumes (Zhang et al. 2011). Errors always have the shape {\"error\": {\"code\", \"message\", \"field\"}}. Ids are opaque strings. Synthesis requests run on a bounded worker pool: when its queue is full the answer is 503 with Retry-After. World units are finest-level voxels."},
+doc = {"openapi": "3.1.0", "info": {"title": "solidtex", "version": "1.0.0", "description": "Lazy solid-texture volumes (Zhang et al. 2011). Errors always have the shape {\"error\": {\"code\", \"message\", \"field\"}}. Ids are opaque strings. Synthesis requests run on a bounded worker pool: when its queue is full the answer is 503 with Retry-After. World units are finest-level voxels. Query parameters are strict: an unknown or repeated one is refused (400). Lists in the query are comma-separated (`size=64,64`). The limits that depend on flags of `solidtex serve` are given with their defaults; over them the answer is 422 (413 only for a body over --max-upload-mb)."},
        "paths": paths, "components": {"schemas": S}}
 
 if __name__ == "__main__":
-    import pathlib, sys
-    target = pathlib.Path(__file__).with_name("openapi.json")
+    import sys
+    target = HERE / "openapi.json"
     text = json.dumps(doc, indent=1)
     if sys.argv[1:] == ["--check"]:
         if target.read_text() != text:

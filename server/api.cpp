@@ -1,6 +1,9 @@
 #include "api.h"
 
+#include <climits>
 #include <cstring>
+#include <map>
+#include <mutex>
 
 #include "http_errors.h"
 #include "core/image_io.h"
@@ -8,6 +11,7 @@
 #include "core/json_fields.h"
 #include "openapi_document.h"
 #include "query_params.h"
+#include "synthesis/target.h"
 #include "vdb_export.h"
 
 namespace solidtex::server {
@@ -125,6 +129,39 @@ HttpResponse respond_bytes(Result<std::vector<uint8_t>> bytes) {
 
 Status no_query(const HttpRequest& r) { return QueryParams::parse(r.query, {}).status(); }
 
+// The contract's ranges (proto/openapi.py): coordinates within +-2^28 voxels; a slice or
+// region side at most 2^24 (the ceiling of --max-voxels, so larger sides could never be
+// answered) with an origin that keeps origin + size within 2^28; a cut side at most 2^20.
+constexpr int64_t kMaxCoordinate = int64_t(1) << 28;
+constexpr int64_t kMaxSide = kMaxTargetSamples;
+constexpr int64_t kMaxOrigin = kMaxCoordinate - kMaxSide;
+constexpr int64_t kMaxCutSide = int64_t(1) << 20;
+
+// The product of positive sides, saturated instead of wrapping (2^24 cubed overflows int64).
+int64_t sample_count(const std::vector<int>& sides) {
+  int64_t n = 1;
+  for (int s : sides) n = n > INT64_MAX / s ? INT64_MAX : n * s;
+  return n;
+}
+
+Status check_each(const std::vector<int>& values, int64_t lo, int64_t hi, const std::string& field) {
+  for (int v : values)
+    if (v < lo || v > hi)
+      return Status(StatusCode::kInvalidArgument, "each must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]", field);
+  return Status::ok();
+}
+
+// Plane weights: each in [0, 1], at least one of them at least 1e-6 (not all zero).
+Status check_plane_weights(const std::vector<double>& w, const std::string& field) {
+  bool any = false;
+  for (double x : w) {
+    if (!(x >= 0 && x <= 1)) return Status(StatusCode::kInvalidArgument, "each must be in [0, 1]", field);
+    any = any || x >= 1e-6;
+  }
+  if (!any) return Status(StatusCode::kInvalidArgument, "must not all be zero (one at least 1e-6)", field);
+  return Status::ok();
+}
+
 }  // namespace
 
 Api::Api(const ServerConfig& config, ExemplarService& exemplars, FieldService& fields, VolumeService& volumes,
@@ -137,7 +174,10 @@ Result<std::unique_ptr<RequestInterrupter>> Api::interrupter_for(const HttpReque
   if (!timeout.empty()) {
     QueryParams q;
     SOLIDTEX_ASSIGN_OR_RETURN(q, QueryParams::parse({{"timeout", timeout}}, {"timeout"}));
-    SOLIDTEX_ASSIGN_OR_RETURN(seconds, q.get_double("timeout", config_.deadline_s, 0.001, config_.max_deadline_s));
+    SOLIDTEX_ASSIGN_OR_RETURN(seconds, q.get_double("timeout", config_.deadline_s, 0, config_.max_deadline_s));
+    if (!(seconds > 0))
+      return Status(StatusCode::kInvalidArgument, "must be in (0, " + std::to_string(config_.max_deadline_s) + "] (--max-deadline)",
+                    "timeout");
   }
   const auto deadline = r.arrival + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
   return std::make_unique<RequestInterrupter>(deadline, r.disconnected, &shutting_down_);
@@ -182,9 +222,33 @@ HttpResponse Api::metrics(const HttpRequest&) {
   return out;
 }
 
+namespace {
+
+// The contract as this server serves it: proto/openapi.json, whose `timeout` parameters say
+// the default --max-deadline (300 s), with this server's --max-deadline instead when it differs
+// (so that a client or fuzzer reading the document never asks for a deadline it would refuse).
+std::string served_openapi(double max_deadline_s) {
+  constexpr double kDocumentedMaxDeadline = 300;
+  if (max_deadline_s == kDocumentedMaxDeadline) return openapi_document();
+  static std::mutex mutex;
+  static std::map<double, std::string> served;
+  std::lock_guard<std::mutex> g(mutex);
+  auto it = served.find(max_deadline_s);
+  if (it != served.end()) return it->second;
+  json doc = json::parse(openapi_document());
+  for (auto& [path, ops] : doc["paths"].items())
+    for (auto& [method, op] : ops.items())
+      if (op.is_object() && op.contains("parameters"))
+        for (auto& p : op["parameters"])
+          if (p.value("name", "") == "timeout" && p.value("in", "") == "query") p["schema"]["maximum"] = max_deadline_s;
+  return served.emplace(max_deadline_s, doc.dump(1)).first->second;
+}
+
+}  // namespace
+
 HttpResponse Api::openapi(const HttpRequest&) {
   HttpResponse out;
-  out.body = openapi_document();
+  out.body = served_openapi(config_.max_deadline_s);
   return out;
 }
 
@@ -200,7 +264,7 @@ HttpResponse Api::upload_exemplar(const HttpRequest& r) {
                                                                           "mask_weight"}));
     ExemplarUpload up;
     up.name = q.get("name").value_or("");
-    if (up.name.size() > 200) return Status(StatusCode::kInvalidArgument, "is longer than 200 characters", "name");
+    if (utf8_length(up.name) > 200) return Status(StatusCode::kInvalidArgument, "is longer than 200 characters", "name");
     SOLIDTEX_ASSIGN_OR_RETURN(up.params.levels, q.get_int("levels", up.params.levels, 1, 8));
     SOLIDTEX_ASSIGN_OR_RETURN(up.params.neighborhood, q.get_int("neighborhood", up.params.neighborhood, 3, 15));
     SOLIDTEX_ASSIGN_OR_RETURN(up.params.candidates, q.get_int("candidates", up.params.candidates, 1, 32));
@@ -209,6 +273,7 @@ HttpResponse Api::upload_exemplar(const HttpRequest& r) {
     up.params.seed = uint32_t(seed);
     if (q.has("plane_weights")) {
       SOLIDTEX_ASSIGN_OR_RETURN(auto w, q.get_list("plane_weights", 3));
+      SOLIDTEX_RETURN_IF_ERROR(check_plane_weights(w, "plane_weights"));
       up.params.suggested_plane_weights = {float(w[0]), float(w[1]), float(w[2])};
     }
     up.grain = q.get("grain").value_or("");
@@ -256,7 +321,7 @@ HttpResponse Api::create_field(const HttpRequest& r) {
     SOLIDTEX_ASSIGN_OR_RETURN(QueryParams q, QueryParams::parse(r.query, {"timeout"}));
     SOLIDTEX_RETURN_IF_ERROR(require_json_body(r));
     auto created = interruptible(r, q.get("timeout").value_or(""), "the field solve",
-                                 [&](Interrupter& i) { return fields_.create(r.body, i); });
+                                 [&](Interrupter& i) { return fields_.create(normalized_body(r.body), i); });
     if (!created) return created.status();
     HttpResponse out = HttpResponse::json(201, *created);
     out.headers.push_back({"Location", "/v1/fields/" + (*created)["id"].get<std::string>()});
@@ -276,7 +341,7 @@ HttpResponse Api::add_curve(const HttpRequest& r) {
     SOLIDTEX_ASSIGN_OR_RETURN(QueryParams q, QueryParams::parse(r.query, {"timeout"}));
     SOLIDTEX_RETURN_IF_ERROR(require_json_body(r));
     auto updated = interruptible(r, q.get("timeout").value_or(""), "the field solve",
-                                 [&](Interrupter& i) { return fields_.add_curve(r.param("id"), r.body, i); });
+                                 [&](Interrupter& i) { return fields_.add_curve(r.param("id"), normalized_body(r.body), i); });
     if (!updated) return updated.status();
     return HttpResponse::json(200, *updated);
   }();
@@ -288,7 +353,7 @@ HttpResponse Api::sample_frames(const HttpRequest& r) {
     SOLIDTEX_ASSIGN_OR_RETURN(QueryParams q, QueryParams::parse(r.query, {"min", "size", "step"}));
     SOLIDTEX_ASSIGN_OR_RETURN(auto min, q.get_list("min", 3));
     SOLIDTEX_ASSIGN_OR_RETURN(auto size, q.get_int_list("size", 3));
-    SOLIDTEX_ASSIGN_OR_RETURN(double step, q.get_double("step", 1.0, 1e-6, 1e6));
+    SOLIDTEX_ASSIGN_OR_RETURN(double step, q.get_double("step", 1.0, 0, 1e6));
     return fields_.sample_frames(r.param("id"), {min[0], min[1], min[2]}, {size[0], size[1], size[2]}, step);
   });
 }
@@ -302,7 +367,7 @@ HttpResponse Api::create_volume(const HttpRequest& r) {
   auto result = [&]() -> Result<HttpResponse> {
     SOLIDTEX_RETURN_IF_ERROR(no_query(r));
     SOLIDTEX_RETURN_IF_ERROR(require_json_body(r));
-    SOLIDTEX_ASSIGN_OR_RETURN(json created, volumes_.create(r.body));
+    SOLIDTEX_ASSIGN_OR_RETURN(json created, volumes_.create(normalized_body(r.body)));
     HttpResponse out = HttpResponse::json(201, created);
     out.headers.push_back({"Location", "/v1/volumes/" + created["id"].get<std::string>()});
     return out;
@@ -330,14 +395,15 @@ HttpResponse Api::slice(const HttpRequest& r) {
     SOLIDTEX_ASSIGN_OR_RETURN(std::string axis, q.required("axis"));
     if (axis != "x" && axis != "y" && axis != "z") return Status(StatusCode::kInvalidArgument, "must be x, y or z", "axis");
     if (!q.has("at")) return Status(StatusCode::kInvalidArgument, "is required", "at");
-    SOLIDTEX_ASSIGN_OR_RETURN(int64_t at, q.get_int("at", 0, -(int64_t(1) << 28), int64_t(1) << 28));
+    SOLIDTEX_ASSIGN_OR_RETURN(int64_t at, q.get_int("at", 0, -kMaxCoordinate, kMaxCoordinate));
     std::vector<int> origin{0, 0};
     if (q.has("origin")) {
       SOLIDTEX_ASSIGN_OR_RETURN(origin, q.get_int_list("origin", 2));
+      SOLIDTEX_RETURN_IF_ERROR(check_each(origin, -kMaxCoordinate, kMaxOrigin, "origin"));
     }
     SOLIDTEX_ASSIGN_OR_RETURN(auto size, q.get_int_list("size", 2));
-    if (size[0] < 1 || size[1] < 1) return Status(StatusCode::kInvalidArgument, "must be positive", "size");
-    SOLIDTEX_RETURN_IF_ERROR(volumes_.check_target_size(int64_t(size[0]) * size[1], "size"));
+    SOLIDTEX_RETURN_IF_ERROR(check_each(size, 1, kMaxSide, "size"));
+    SOLIDTEX_RETURN_IF_ERROR(volumes_.check_target_size(sample_count(size), "size"));
     SOLIDTEX_ASSIGN_OR_RETURN(TargetSet target, TargetSet::axis_cut(axis[0], int(at), origin[0], origin[1], size[0], size[1]));
     return synthesize_image(r, "slice", target, q.get("timeout").value_or(""));
   }();
@@ -348,7 +414,7 @@ HttpResponse Api::cut(const HttpRequest& r) {
   auto result = [&]() -> Result<HttpResponse> {
     SOLIDTEX_ASSIGN_OR_RETURN(QueryParams q, QueryParams::parse(r.query, {"timeout"}));
     SOLIDTEX_RETURN_IF_ERROR(require_json_body(r));
-    SOLIDTEX_ASSIGN_OR_RETURN(json j, parse_json_text(r.body, "body"));
+    SOLIDTEX_ASSIGN_OR_RETURN(json j, parse_request_json(r.body, "body"));
     SOLIDTEX_RETURN_IF_ERROR(check_keys(j, {"origin", "u", "v", "size"}, ""));
     for (const char* k : {"origin", "u", "v", "size"})
       if (!j.contains(k)) return Status(StatusCode::kInvalidArgument, "is required", k);
@@ -357,8 +423,8 @@ HttpResponse Api::cut(const HttpRequest& r) {
     SOLIDTEX_ASSIGN_OR_RETURN(WorldPoint v, json_point(j["v"], "v"));
     if (!j["size"].is_array() || j["size"].size() != 2)
       return Status(StatusCode::kInvalidArgument, "must be [W, H]", "size");
-    SOLIDTEX_ASSIGN_OR_RETURN(int64_t w, json_int(j["size"][0], "size", 1, 1 << 20));
-    SOLIDTEX_ASSIGN_OR_RETURN(int64_t h, json_int(j["size"][1], "size", 1, 1 << 20));
+    SOLIDTEX_ASSIGN_OR_RETURN(int64_t w, json_int(j["size"][0], "size", 1, kMaxCutSide));
+    SOLIDTEX_ASSIGN_OR_RETURN(int64_t h, json_int(j["size"][1], "size", 1, kMaxCutSide));
     SOLIDTEX_RETURN_IF_ERROR(volumes_.check_target_size(w * h, "size"));
     SOLIDTEX_ASSIGN_OR_RETURN(TargetSet target, TargetSet::plane_cut(origin, u, v, int(w), int(h)));
     return synthesize_image(r, "cut", target, q.get("timeout").value_or(""));
@@ -370,9 +436,11 @@ HttpResponse Api::region(const HttpRequest& r) {
   auto result = [&]() -> Result<HttpResponse> {
     SOLIDTEX_ASSIGN_OR_RETURN(QueryParams q, QueryParams::parse(r.query, {"min", "size", "timeout"}));
     SOLIDTEX_ASSIGN_OR_RETURN(auto min, q.get_int_list("min", 3));
+    SOLIDTEX_RETURN_IF_ERROR(check_each(min, -kMaxCoordinate, kMaxOrigin, "min"));
     SOLIDTEX_ASSIGN_OR_RETURN(auto size, q.get_int_list("size", 3));
-    if (size[0] < 1 || size[1] < 1 || size[2] < 1) return Status(StatusCode::kInvalidArgument, "must be positive", "size");
-    SOLIDTEX_RETURN_IF_ERROR(volumes_.check_target_size(int64_t(size[0]) * size[1] * size[2], "size"));
+    SOLIDTEX_RETURN_IF_ERROR(check_each(size, 1, kMaxSide, "size"));
+    // Saturated: W*H*D once wrapped int64 to a small number that passed the limit (500, bad_alloc).
+    SOLIDTEX_RETURN_IF_ERROR(volumes_.check_target_size(sample_count(size), "size"));
     SOLIDTEX_ASSIGN_OR_RETURN(TargetSet target, TargetSet::box(Voxel{min[0], min[1], min[2]}, size[0], size[1], size[2]));
     auto qr = query_volume(r, "region", target, q.get("timeout").value_or(""));
     if (!qr) return qr.status();
@@ -397,7 +465,7 @@ HttpResponse Api::points(const HttpRequest& r) {
     SOLIDTEX_ASSIGN_OR_RETURN(QueryParams q, QueryParams::parse(r.query, {"timeout"}));
     std::vector<WorldPoint> pts;
     if (r.content_type == "application/json") {
-      SOLIDTEX_ASSIGN_OR_RETURN(json j, parse_json_text(r.body, "body"));
+      SOLIDTEX_ASSIGN_OR_RETURN(json j, parse_request_json(r.body, "body"));
       SOLIDTEX_RETURN_IF_ERROR(check_keys(j, {"points"}, ""));
       if (!j.contains("points") || !j["points"].is_array())
         return Status(StatusCode::kInvalidArgument, "is required (an array of [x,y,z])", "points");
@@ -450,7 +518,7 @@ HttpResponse Api::upload_mesh(const HttpRequest& r) {
   auto result = [&]() -> Result<HttpResponse> {
     SOLIDTEX_ASSIGN_OR_RETURN(QueryParams q, QueryParams::parse(r.query, {"name"}));
     const std::string name = q.get("name").value_or("");
-    if (name.size() > 200) return Status(StatusCode::kInvalidArgument, "is longer than 200 characters", "name");
+    if (utf8_length(name) > 200) return Status(StatusCode::kInvalidArgument, "is longer than 200 characters", "name");
     if (r.content_type == "application/json" || r.multipart)
       return Status(StatusCode::kUnsupported, "send the mesh file's bytes (OBJ, PLY or OFF)", "Content-Type");
     SOLIDTEX_ASSIGN_OR_RETURN(json created, meshes_.upload(std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(r.body.data()), r.body.size()), name));
@@ -478,16 +546,28 @@ HttpResponse Api::surface(const HttpRequest& r) {
     std::string format = "ply";
     std::vector<std::array<double, 3>> extra;
     std::string timeout;
+    if (r.multipart) return Status(StatusCode::kUnsupported, "send the mesh bytes or a JSON request", "Content-Type");
+    SOLIDTEX_ASSIGN_OR_RETURN(QueryParams q, QueryParams::parse(r.query, {"timeout", "resolution", "margin", "format"}));
+    timeout = q.get("timeout").value_or("");
+    // With a mesh body these place the mesh and choose the answer; with a JSON body they are
+    // defaults for what the body leaves out.
+    format = q.get("format").value_or("ply");
+    SOLIDTEX_ASSIGN_OR_RETURN(int64_t resolution, q.get_int("resolution", 512, 8, 4096));
+    SOLIDTEX_ASSIGN_OR_RETURN(double margin, q.get_double("margin", 0.25, 0, 1));
+    if (format != "ply" && format != "json") return Status(StatusCode::kInvalidArgument, "must be ply or json", "format");
     if (r.content_type == "application/json") {
-      SOLIDTEX_ASSIGN_OR_RETURN(QueryParams q, QueryParams::parse(r.query, {"timeout"}));
-      timeout = q.get("timeout").value_or("");
-      SOLIDTEX_ASSIGN_OR_RETURN(json j, parse_json_text(r.body, "body"));
+      SOLIDTEX_ASSIGN_OR_RETURN(json j, parse_request_json(r.body, "body"));
       SOLIDTEX_RETURN_IF_ERROR(check_keys(j, {"mesh", "placement", "format", "points"}, ""));
       if (!j.contains("mesh")) return Status(StatusCode::kInvalidArgument, "is required", "mesh");
-      SOLIDTEX_ASSIGN_OR_RETURN(std::string mesh_id, json_string(j["mesh"], "mesh", 64));
+      SOLIDTEX_ASSIGN_OR_RETURN(std::string mesh_id, json_text(j["mesh"], "mesh", 64));
       SOLIDTEX_ASSIGN_OR_RETURN(mesh, meshes_.mesh(mesh_id));
-      SOLIDTEX_ASSIGN_OR_RETURN(placement, placement_from_json(j.value("placement", json::object()), "placement", mesh->bounds(), nullptr));
-      if (j.contains("format")) { SOLIDTEX_ASSIGN_OR_RETURN(format, json_string(j["format"], "format")); }
+      json pj = j.value("placement", json::object());
+      if (pj.is_object() && !pj.contains("scale")) {
+        if (!pj.contains("resolution") && q.has("resolution")) pj["resolution"] = resolution;
+        if (!pj.contains("margin") && q.has("margin")) pj["margin"] = margin;
+      }
+      SOLIDTEX_ASSIGN_OR_RETURN(placement, placement_from_json(pj, "placement", mesh->bounds(), nullptr));
+      if (j.contains("format")) { SOLIDTEX_ASSIGN_OR_RETURN(format, json_text(j["format"], "format")); }
       if (j.contains("points")) {
         if (!j["points"].is_array()) return Status(StatusCode::kInvalidArgument, "must be an array of [x,y,z]", "points");
         for (size_t i = 0; i < j["points"].size(); ++i) {
@@ -496,12 +576,6 @@ HttpResponse Api::surface(const HttpRequest& r) {
         }
       }
     } else {
-      if (r.multipart) return Status(StatusCode::kUnsupported, "send the mesh bytes or a JSON request", "Content-Type");
-      SOLIDTEX_ASSIGN_OR_RETURN(QueryParams q, QueryParams::parse(r.query, {"timeout", "resolution", "margin", "format"}));
-      timeout = q.get("timeout").value_or("");
-      format = q.get("format").value_or("ply");
-      SOLIDTEX_ASSIGN_OR_RETURN(int64_t resolution, q.get_int("resolution", 512, 8, 4096));
-      SOLIDTEX_ASSIGN_OR_RETURN(double margin, q.get_double("margin", 0.25, 0, 1));
       SOLIDTEX_ASSIGN_OR_RETURN(Mesh decoded, meshes_.decode(std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(r.body.data()), r.body.size())));
       mesh = std::make_shared<const Mesh>(std::move(decoded));
       SOLIDTEX_ASSIGN_OR_RETURN(placement, fit_placement(mesh->bounds(), int(resolution), margin));
@@ -554,13 +628,13 @@ HttpResponse Api::field_from_mesh(const HttpRequest& r) {
   auto result = [&]() -> Result<HttpResponse> {
     SOLIDTEX_ASSIGN_OR_RETURN(QueryParams q, QueryParams::parse(r.query, {"timeout"}));
     SOLIDTEX_RETURN_IF_ERROR(require_json_body(r));
-    SOLIDTEX_ASSIGN_OR_RETURN(json j, parse_json_text(r.body, "body"));
+    SOLIDTEX_ASSIGN_OR_RETURN(json j, parse_request_json(r.body, "body"));
     SOLIDTEX_RETURN_IF_ERROR(check_keys(j, {"mesh", "kind", "placement", "shortest_side_cells", "max_constraints",
                                             "feature_angle_degrees", "curves"}, ""));
     for (const char* k : {"mesh", "kind"})
       if (!j.contains(k)) return Status(StatusCode::kInvalidArgument, "is required", k);
-    SOLIDTEX_ASSIGN_OR_RETURN(std::string mesh_id, json_string(j["mesh"], "mesh", 64));
-    SOLIDTEX_ASSIGN_OR_RETURN(std::string kind, json_string(j["kind"], "kind"));
+    SOLIDTEX_ASSIGN_OR_RETURN(std::string mesh_id, json_text(j["mesh"], "mesh", 64));
+    SOLIDTEX_ASSIGN_OR_RETURN(std::string kind, json_text(j["kind"], "kind"));
     MeshFieldOptions o;
     if (kind == "curvature") o.kind = MeshFieldOptions::Kind::kCurvature;
     else if (kind == "features") o.kind = MeshFieldOptions::Kind::kFeatures;

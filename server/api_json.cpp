@@ -1,6 +1,8 @@
 #include "api_json.h"
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <set>
 #include <string>
@@ -54,6 +56,7 @@ template <typename... F>
 struct Overloaded : F... {
   using F::operator()...;
 };
+template <typename... F> Overloaded(F...) -> Overloaded<F...>;  // clang < 17: no aggregate CTAD
 
 // A named enum value; the parser's message (e.g. "scheme 'standard' was renamed 'plain' ...")
 // is kept, the field becomes the value's path.
@@ -82,10 +85,14 @@ Status read_param(const Param<P>& d, const json& v, const std::string& field, P&
           },
           [&](std::array<float, 3> P::*m) -> Status {
             if (!v.is_array() || v.size() != 3) return Status(StatusCode::kInvalidArgument, "must be 3 numbers", field);
+            double largest = 0;
             for (size_t i = 0; i < 3; ++i) {
               SOLIDTEX_ASSIGN_OR_RETURN(double x, json_number(v[i], field, double(d.lo), double(d.hi)));
               (p.*m)[i] = float(x);
+              largest = std::max(largest, x);
             }
+            // The triples are plane weights: not all zero, and none that float would make zero.
+            if (!(largest >= 1e-6)) return Status(StatusCode::kInvalidArgument, "must not all be zero (one at least 1e-6)", field);
             return Status::ok();
           },
           [&](Scheme P::*m) { return read_name(v, field, &parse_scheme, p.*m); },
@@ -169,6 +176,44 @@ Result<Placement> placement_from_json(const json& j, const std::string& where, c
   int64_t resolution = 512;
   if (j.contains("resolution")) { SOLIDTEX_ASSIGN_OR_RETURN(resolution, json_int(j["resolution"], where + ".resolution", 8, 4096)); }
   return fit_placement(bounds, int(resolution), m);
+}
+
+size_t utf8_length(std::string_view s) {
+  size_t n = 0;
+  for (const char c : s)
+    if ((static_cast<unsigned char>(c) & 0xC0) != 0x80) ++n;  // count every byte that starts a character
+  return n;
+}
+
+Result<std::string> json_text(const json& j, const std::string& where, size_t max_chars) {
+  if (!j.is_string()) return Status(StatusCode::kInvalidArgument, "must be a string", where);
+  std::string s = j.get<std::string>();
+  if (utf8_length(s) > max_chars)
+    return Status(StatusCode::kInvalidArgument, "is longer than " + std::to_string(max_chars) + " characters", where);
+  return s;
+}
+
+namespace {
+void integral_floats_to_integers(json& j) {
+  if (j.is_number_float()) {
+    const double d = j.get<double>();
+    // Exactly representable as int64 (|d| < 2^63); larger integral floats stay floats.
+    if (std::isfinite(d) && d == std::floor(d) && std::fabs(d) < 9.2e18) j = int64_t(d);
+  } else if (j.is_array() || j.is_object()) {
+    for (auto& v : j) integral_floats_to_integers(v);
+  }
+}
+}  // namespace
+
+Result<json> parse_request_json(const std::string& text, const std::string& where) {
+  SOLIDTEX_ASSIGN_OR_RETURN(json j, parse_json_text(text, where));
+  integral_floats_to_integers(j);
+  return j;
+}
+
+std::string normalized_body(const std::string& text) {
+  auto j = parse_request_json(text, "body");
+  return j ? j->dump() : text;
 }
 
 json status_json(const Status& s) {

@@ -147,15 +147,13 @@ struct ExemplarService::Impl {
     }
   }
 
-  void run_analysis(const std::string& id) {
+  // `attempt` was made durable (worker) before the job showed as running.
+  void run_analysis(const std::string& id, int attempt) {
     json meta;
     {
       std::lock_guard<std::mutex> g(mutex);
       meta = entries.at(id).meta;
     }
-    // Durable before the work starts, so a crash during it is counted at the next start.
-    const int attempt = attempts(id) + 1;
-    (void)store.write_text(ResourceKind::kExemplar, id, "attempts", std::to_string(attempt));
     const auto t0 = std::chrono::steady_clock::now();
     auto result = [&]() -> Result<json> {
       std::vector<std::pair<std::string, std::vector<uint8_t>>> parts;
@@ -217,12 +215,25 @@ struct ExemplarService::Impl {
         if (stopping.load()) return;
         id = pending.front();
         pending.pop_front();
-        auto it = entries.find(id);
-        if (it == entries.end()) continue;
-        it->second.state = State::kRunning;
-        ++running;
+        if (!entries.count(id)) continue;
+        ++running;  // counted against --max-jobs from here on
       }
-      run_analysis(id);
+      // Durable before the job shows as running and its work starts, so that a crash from then
+      // on is counted at the next start (a client that sees "running" and kills the server has
+      // used one attempt).
+      const int attempt = attempts(id) + 1;
+      (void)store.write_text(ResourceKind::kExemplar, id, "attempts", std::to_string(attempt));
+      {
+        std::lock_guard<std::mutex> g(mutex);
+        auto it = entries.find(id);
+        if (it == entries.end() || it->second.state != State::kQueued) {  // deleted meanwhile
+          --running;
+          finished.notify_all();
+          continue;
+        }
+        it->second.state = State::kRunning;
+      }
+      run_analysis(id, attempt);
       std::lock_guard<std::mutex> g(mutex);
       --running;
       auto it = entries.find(id);

@@ -5,12 +5,19 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
 #include "core/status.h"
 
 namespace solidtex::server {
+
+// A JSON number (RFC 8259 section 6, leading zeros allowed): the only number syntax the
+// contract's query values and text specs take (no spaces, '+', hex, inf or nan).
+bool is_number_text(std::string_view s);
+// Exactly `count` comma-separated JSON numbers.
+bool is_number_list_text(std::string_view s, size_t count);
 
 class QueryParams {
  public:

@@ -78,19 +78,32 @@ bool matches(const std::vector<std::string>& tmpl, const std::vector<std::string
 
 }  // namespace
 
+// A path that a literal template matches (/v1/fields/from-mesh) belongs to it alone, not also
+// to a template with a parameter in that place (/v1/fields/{id}): only the templates with the
+// most literal segments among those that match count, for the handler and for Allow.
 const Route* match_route(const std::string& method, const std::string& path, std::map<std::string, std::string>& params,
                          std::vector<std::string>& allowed) {
   const auto parts = segments(path);
   const Route* hit = nullptr;
+  size_t best = 0;
+  std::vector<std::string> methods;
   for (const Route& r : route_table()) {
     std::map<std::string, std::string> p;
     if (!matches(segments(r.path), parts, p)) continue;
-    allowed.push_back(r.method);
+    const size_t literals = parts.size() - p.size();
+    if (literals < best) continue;
+    if (literals > best) {
+      best = literals;
+      methods.clear();
+      hit = nullptr;
+    }
+    methods.push_back(r.method);
     if (!hit && method == r.method) {
       hit = &r;
       params = std::move(p);
     }
   }
+  allowed.insert(allowed.end(), methods.begin(), methods.end());
   return hit;
 }
 

@@ -55,6 +55,15 @@ TEST(Routes, MatchesTemplatesAndReportsAllowedMethods) {
   EXPECT_EQ(match_route("PUT", "/v1/volumes", params, allowed), nullptr);
   EXPECT_EQ(std::set<std::string>(allowed.begin(), allowed.end()), (std::set<std::string>{"GET", "POST"}));
 
+  // A literal path belongs to its own route only: not also to /v1/fields/{id}.
+  allowed.clear();
+  EXPECT_EQ(match_route("GET", "/v1/fields/from-mesh", params, allowed), nullptr);
+  EXPECT_EQ(allowed, (std::vector<std::string>{"POST"}));
+  allowed.clear();
+  r = match_route("GET", "/v1/fields/fld_1", params, allowed);
+  ASSERT_NE(r, nullptr);
+  EXPECT_STREQ(r->path, "/v1/fields/{id}");
+
   allowed.clear();
   EXPECT_EQ(match_route("GET", "/v1/nothing/here", params, allowed), nullptr);
   EXPECT_TRUE(allowed.empty());

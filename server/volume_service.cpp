@@ -5,10 +5,12 @@
 #include <deque>
 #include <map>
 #include <mutex>
+#include <string_view>
 
 #include "api_json.h"
 #include "field/field_file.h"
 #include "core/json_fields.h"
+#include "query_params.h"
 #include "synthesis/region_volume.h"
 #include "synthesis/synthesizer.h"
 
@@ -19,6 +21,25 @@ using nlohmann::json;
 namespace {
 
 constexpr size_t kRecentRequests = 16;
+
+// The patterns of regions.label and field.spec in proto/volume.schema.json, matched exactly
+// (without std::regex, whose recursion a long string could exhaust).
+bool starts_with(std::string_view s, std::string_view prefix) { return s.substr(0, prefix.size()) == prefix; }
+bool label_matches(std::string_view s) {
+  if (starts_with(s, "halfspace:")) return is_number_list_text(s.substr(10), 4);
+  if (starts_with(s, "box:")) return is_number_list_text(s.substr(4), 6);
+  if (starts_with(s, "surface:")) return is_number_list_text(s.substr(8), 1);
+  return false;
+}
+bool field_spec_matches(std::string_view s) {
+  if (const size_t semi = s.find(";scale:"); semi != std::string_view::npos) {
+    if (!is_number_list_text(s.substr(semi + 7), 3)) return false;
+    s = s.substr(0, semi);
+  }
+  if (s == "identity") return true;
+  if (starts_with(s, "quat:") || starts_with(s, "axis:")) return is_number_list_text(s.substr(5), 4);
+  return false;
+}
 
 struct Volume {
   json info;                                  // volume.json (the spec as given, plus id)
@@ -96,11 +117,11 @@ struct VolumeService::Impl {
   Result<std::shared_ptr<Volume>> parse_spec(const json& j, std::vector<uint8_t>* field_bytes, json* field_desc) {
     SOLIDTEX_RETURN_IF_ERROR(check_keys(j, {"id", "name", "exemplar", "regions", "field", "seed", "params"}, ""));
     auto v = std::make_shared<Volume>();
-    if (j.contains("name")) { SOLIDTEX_RETURN_IF_ERROR(json_string(j["name"], "name", 200).status()); }
+    if (j.contains("name")) { SOLIDTEX_RETURN_IF_ERROR(json_text(j["name"], "name", 200).status()); }
     if (j.contains("exemplar") == j.contains("regions"))
       return Status(StatusCode::kInvalidArgument, "give exactly one of 'exemplar' and 'regions'", "exemplar");
     if (j.contains("exemplar")) {
-      SOLIDTEX_ASSIGN_OR_RETURN(std::string e, json_string(j["exemplar"], "exemplar", 64));
+      SOLIDTEX_ASSIGN_OR_RETURN(std::string e, json_text(j["exemplar"], "exemplar", 64));
       v->exemplar_ids.push_back(e);
     } else {
       const json& r = j["regions"];
@@ -108,11 +129,14 @@ struct VolumeService::Impl {
       if (!r.contains("exemplars") || !r["exemplars"].is_array() || r["exemplars"].size() != 2)
         return Status(StatusCode::kInvalidArgument, "must be an array of two exemplar ids", "regions.exemplars");
       for (size_t i = 0; i < 2; ++i) {
-        SOLIDTEX_ASSIGN_OR_RETURN(std::string e, json_string(r["exemplars"][i], "regions.exemplars[" + std::to_string(i) + "]", 64));
+        SOLIDTEX_ASSIGN_OR_RETURN(std::string e, json_text(r["exemplars"][i], "regions.exemplars[" + std::to_string(i) + "]", 64));
         v->exemplar_ids.push_back(e);
       }
       if (!r.contains("label")) return Status(StatusCode::kInvalidArgument, "is required", "regions.label");
-      SOLIDTEX_ASSIGN_OR_RETURN(std::string label, json_string(r["label"], "regions.label"));
+      SOLIDTEX_ASSIGN_OR_RETURN(std::string label, json_text(r["label"], "regions.label"));
+      if (!label_matches(label))
+        return Status(StatusCode::kInvalidArgument,
+                      "must be halfspace:NX,NY,NZ,D, box:X0,Y0,Z0,X1,Y1,Z1 or surface:D (plain decimal numbers)", "regions.label");
       auto parsed = RegionLabel::parse(label);
       if (!parsed) return Status(StatusCode::kInvalidArgument, parsed.status().message(), "regions.label");
       v->label = *parsed;
@@ -123,7 +147,7 @@ struct VolumeService::Impl {
       if (shell) {
         SOLIDTEX_RETURN_IF_ERROR(check_keys(r["mesh"], {"id", "placement"}, "regions.mesh"));
         if (!r["mesh"].contains("id")) return Status(StatusCode::kInvalidArgument, "is required", "regions.mesh.id");
-        SOLIDTEX_RETURN_IF_ERROR(json_string(r["mesh"]["id"], "regions.mesh.id", 64).status());
+        SOLIDTEX_RETURN_IF_ERROR(json_text(r["mesh"]["id"], "regions.mesh.id", 64).status());
       }
     }
     if (j.contains("seed")) {
@@ -143,15 +167,14 @@ struct VolumeService::Impl {
       if (f.contains("id") == f.contains("spec"))
         return Status(StatusCode::kInvalidArgument, "give exactly one of 'id' and 'spec'", "field");
       if (f.contains("spec")) {
-        SOLIDTEX_ASSIGN_OR_RETURN(spec, json_string(f["spec"], "field.spec"));
-        // Only the inline forms: a spec must never name a file on the server.
-        if (!(spec == "identity" || spec.rfind("identity;", 0) == 0 || spec.rfind("quat:", 0) == 0 ||
-              spec.rfind("axis:", 0) == 0))
+        SOLIDTEX_ASSIGN_OR_RETURN(spec, json_text(f["spec"], "field.spec"));
+        // Only the inline forms, exactly: a spec must never name a file on the server.
+        if (!field_spec_matches(spec))
           return Status(StatusCode::kInvalidArgument, "must be identity, quat:W,X,Y,Z or axis:AX,AY,AZ,DEG (optionally ;scale:SX,SY,SZ)",
                         "field.spec");
         *field_desc = json{{"kind", "spec"}, {"spec", spec}};
       } else {
-        SOLIDTEX_ASSIGN_OR_RETURN(std::string fid, json_string(f["id"], "field.id", 64));
+        SOLIDTEX_ASSIGN_OR_RETURN(std::string fid, json_text(f["id"], "field.id", 64));
         if (field_bytes) {  // creating: copy the field's current revision
           int revision = 0;
           auto bytes = fields.file_bytes(fid, &revision);

@@ -66,7 +66,10 @@ RequestCost estimate_cost(const std::vector<LevelSchedule>& schedules, const Fra
   const int L = stencils.levels();
   const std::vector<VoxelBox> boxes = dependency_boxes(schedules, stencils, target.bounds());
   cost.levels.resize(size_t(L));
-  int64_t need = int64_t(target.voxels.size());
+  // Every set voxel of level l lies within `radius` (its own voxels, per axis) of some target
+  // voxel's position on that level: the level's spread plus the finer level's radius halved.
+  const int64_t targets = int64_t(target.voxels.size());
+  int64_t radius = 0;
   VoxelBox served = target.bounds();
   std::vector<int64_t> store(size_t(L), 0);
   int64_t masks = 0;
@@ -74,8 +77,9 @@ RequestCost estimate_cost(const std::vector<LevelSchedule>& schedules, const Fra
     const LevelSchedule& sch = schedules[size_t(l)];
     const VoxelBox& box = boxes[size_t(l)];
     const VoxelBox set_box = served.dilated(spread[size_t(l)]);
-    const int64_t side = 2 * int64_t(spread[size_t(l)]) + 1;
-    const int64_t voxels = std::min(box_volume(set_box), sat_mul(need, sat_mul(side, sat_mul(side, side))));
+    radius = (l == L - 1 ? 0 : radius / 2 + 1) + spread[size_t(l)];
+    const int64_t side = 2 * radius + 1;
+    const int64_t voxels = std::min(box_volume(set_box), sat_mul(targets, sat_mul(side, sat_mul(side, side))));
     const int64_t bricks = std::min(box_bricks(set_box), voxels);
     const int64_t versions = sch.final_version() + 1;
     const int64_t mask_bytes = sat_mul(versions, sat_mul(box_bricks(box), kMaskTableBytesPerBrick) +
@@ -88,10 +92,9 @@ RequestCost estimate_cost(const std::vector<LevelSchedule>& schedules, const Fra
     lc.bytes = mask_bytes + store[size_t(l)];
     cost.voxels = std::min(cost.voxels + voxels, int64_t(1) << 62);
     masks = std::min(masks + mask_bytes, int64_t(1) << 62);
-    // Parents of a set are at most as many as its voxels, and lie in the parents' box.
+    // The parents the set needs lie in the parents' box.
     served = {parent_of(set_box.lo), {floor_div(set_box.hi.x - 1, 2) + 1, floor_div(set_box.hi.y - 1, 2) + 1,
                                       floor_div(set_box.hi.z - 1, 2) + 1}};
-    need = std::min(voxels, box_volume(served));
   }
   int64_t peak_stores = 0;
   for (int l = 0; l < L; ++l) peak_stores = std::max(peak_stores, store[size_t(l)] + (l > 0 ? store[size_t(l - 1)] : 0));

@@ -6,7 +6,8 @@
 // reach (subpasses update one voxel class per step; grid barriers stop reads at cell borders),
 // so measure_spread() measures it once per synthesizer with the real dependency analysis of
 // a few single-voxel probes. estimate_cost() then bounds, per level,
-//   voxels <= min(volume of the served box dilated by the spread, served voxels x (2 spread + 1)^3)
+//   voxels <= min(volume of the served box dilated by the spread, targets x (2 radius + 1)^3)
+// where radius (in the level's voxels) is the spread plus half the finer level's radius, plus one
 // and bytes: the dense brick tables over the level's dependency box (one per version), mask
 // bricks, and store bricks (512 voxels x slots x VoxelState each). It touches no voxel, so a
 // service can refuse a request before allocating; the synthesizer checks the exact store size
