@@ -70,6 +70,8 @@ Result<std::shared_ptr<const QuatGridField>> QuatGridField::create(WorldPoint or
                                                                    std::array<int, 3> dims, std::vector<Quat> values,
                                                                    std::vector<std::array<double, 3>> log_scales) {
   if (!(spacing > 0) || !std::isfinite(spacing)) return Status(StatusCode::kInvalidArgument, "must be > 0", "spacing");
+  if (!std::isfinite(origin.x) || !std::isfinite(origin.y) || !std::isfinite(origin.z))
+    return Status(StatusCode::kInvalidArgument, "must be finite", "origin");
   for (int d : dims)
     if (d < 2 || d > 1024) return Status(StatusCode::kInvalidArgument, "each must be in [2, 1024]", "dims");
   if (values.size() != size_t(dims[0]) * dims[1] * dims[2])
@@ -105,7 +107,8 @@ Result<std::shared_ptr<const QuatGridField>> QuatGridField::create(WorldPoint or
 void QuatGridField::cell(const WorldPoint& p, int i0[3], double f[3]) const {
   const double g[3] = {(p.x - origin_.x) / spacing_, (p.y - origin_.y) / spacing_, (p.z - origin_.z) / spacing_};
   for (int a = 0; a < 3; ++a) {
-    double c = std::clamp(g[a], 0.0, double(dims_[a] - 1));
+    // NaN (a non-finite query point) takes the first cell instead of an undefined int cast.
+    double c = std::isnan(g[a]) ? 0.0 : std::clamp(g[a], 0.0, double(dims_[a] - 1));
     i0[a] = std::min(int(std::floor(c)), dims_[a] - 2);
     f[a] = c - i0[a];
   }

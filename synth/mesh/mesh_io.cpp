@@ -60,6 +60,13 @@ bool to_double(std::string_view s, double& v) {
   auto r = std::from_chars(s.data(), s.data() + s.size(), v);
   return r.ec == std::errc() && r.ptr == s.data() + s.size();
 }
+// A count or index read as a floating-point PLY value: integral, finite and within [0, 2^62].
+bool as_count(double x, int64_t& out) {
+  if (!(x >= 0 && x <= 4.6e18) || x != std::floor(x)) return false;
+  out = int64_t(x);
+  return true;
+}
+
 bool to_int(std::string_view s, int64_t& v) {
   auto r = std::from_chars(s.data(), s.data() + s.size(), v);
   return r.ec == std::errc() && r.ptr == s.data() + s.size();
@@ -105,7 +112,7 @@ Result<RawMesh> read_off(std::string_view text, const MeshLimits& limits) {
     const std::string where = "face " + std::to_string(i);
     if (!in.next(t)) return corrupt(where, "OFF ends before all faces (truncated)");
     int64_t k = 0;
-    if (!to_int(t[0], k) || k < 3 || int64_t(t.size()) < k + 1)
+    if (!to_int(t[0], k) || k < 3 || k > int64_t(t.size()) - 1)
       return corrupt(where, "line " + std::to_string(in.line()) + ": expected a count >= 3 and that many indices");
     std::vector<int64_t> f(static_cast<size_t>(k));
     for (int64_t j = 0; j < k; ++j)
@@ -295,12 +302,16 @@ Result<RawMesh> read_ply(std::span<const uint8_t> bytes, const MeshLimits& limit
           double val = 0;
           if (tok >= t.size() || !to_double(t[tok++], val)) return corrupt(where, "PLY: bad or missing value");
           if (p.list) {
-            const int64_t n = int64_t(val);
-            if (n < 0 || tok + size_t(n) > t.size()) return corrupt(where, "PLY: bad list length");
+            int64_t n = 0;
+            if (!as_count(val, n) || n > int64_t(t.size() - tok)) return corrupt(where, "PLY: bad list length");
             for (int64_t j = 0; j < n; ++j) {
               double x = 0;
               if (!to_double(t[tok++], x)) return corrupt(where, "PLY: bad list value");
-              if (int(k) == indices) f.push_back(int64_t(x));
+              int64_t index = 0;
+              if (int(k) == indices) {
+                if (!as_count(x, index)) return corrupt(where, "PLY: a vertex index is not a non-negative integer");
+                f.push_back(index);
+              }
             }
           } else if (is_vertex) {
             for (int a = 0; a < 3; ++a)
@@ -313,12 +324,17 @@ Result<RawMesh> read_ply(std::span<const uint8_t> bytes, const MeshLimits& limit
           double val = 0;
           if (!bin.read(p.list ? p.count_type : p.type, val)) return corrupt(where, "PLY ends early (truncated)");
           if (p.list) {
-            const int64_t n = int64_t(val);
-            if (n < 0 || size_t(n) * ply_size(p.type) > bin.remaining()) return corrupt(where, "PLY: bad list length (truncated?)");
+            int64_t n = 0;
+            if (!as_count(val, n) || n > int64_t(bin.remaining() / ply_size(p.type)))
+              return corrupt(where, "PLY: bad list length (truncated?)");
             for (int64_t j = 0; j < n; ++j) {
               double x = 0;
               bin.read(p.type, x);
-              if (int(k) == indices) f.push_back(int64_t(x));
+              int64_t index = 0;
+              if (int(k) == indices) {
+                if (!as_count(x, index)) return corrupt(where, "PLY: a vertex index is not a non-negative integer");
+                f.push_back(index);
+              }
             }
           } else if (is_vertex) {
             for (int a = 0; a < 3; ++a)
