@@ -6,7 +6,7 @@ PORT ?= 8080
 FUZZ_DIR ?= build-fuzz
 ASAN_DIR ?= build-asan
 FUZZ_SECONDS ?= 120       # per harness, make fuzz
-FUZZ_TEST_SECONDS ?= 0    # per harness, a short run at the end of make test (0: none; see fuzz/README.md)
+FUZZ_TEST_SECONDS ?= 10   # per harness, a short run at the end of make test (0: none; see fuzz/README.md)
 
 .PHONY: deps configure build python test serve bench clean fuzz fuzz-build test-sanitize
 

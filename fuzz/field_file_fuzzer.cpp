@@ -2,8 +2,10 @@
 // with it (QuatGridField::create, as load_field and the volume service do; the stored sketch
 // is re-parsed when a curve is added). Each input is decoded as given and with its size and
 // checksum fields recomputed (fuzz_support.h), so mutated payloads reach the payload decoder.
-// Checked: encode_field(decode_field(x)) == x; an accepted grid field answers finite unit
-// quaternions and scales within [0.25, 4] everywhere, inside and outside the grid.
+// Checked: encode_field(decode_field(x)) == x; what decode_field accepts loads
+// (QuatGridField::create accepts it); the grid field answers finite unit quaternions and
+// scales within [0.25, 4] everywhere, inside and outside the grid, and node 0's frame at the
+// grid's origin.
 #include <algorithm>
 #include <cmath>
 
@@ -54,7 +56,8 @@ void decode_and_check(std::span<const uint8_t> file) {
   const std::vector<uint8_t> again = encode_field(*f);
   FUZZ_CHECK(again.size() == file.size() && std::equal(again.begin(), again.end(), file.begin()));
   auto grid = QuatGridField::create(f->origin, f->spacing, f->dims, f->nodes, f->log_scales);
-  if (grid) check_grid(**grid, *f);
+  FUZZ_CHECK(grid.is_ok());
+  check_grid(**grid, *f);
   (void)parse_sketch_json(f->sketch_json);
 }
 

@@ -33,6 +33,24 @@ convert --compression none -o "$out/image/stripes.tif"
 convert -d half --compression zip -o "$out/image/stripes.exr"
 convert --ch R -d uint16 -o "$out/image/gray16.png"
 convert --ch R,G,B,A=1.0 -o "$out/image/rgba.png"
+# Reproducers of decode_image findings (fuzz/README.md), made from stripes.exr (8x12, one zip
+# chunk): that chunk replaced by a zlib stream of 10 bytes where 576 are needed (OpenEXR's
+# classic reader returned uninitialised memory as pixels), and its chunk table entry set to -8
+# (OIIO 2.4's IOMemReader::pread then read the 8 bytes before the buffer).
+python3 - "$out/image" <<'EOF'
+import struct, sys
+d = sys.argv[1]
+b = open(f"{d}/stripes.exr", "rb").read()
+i = 8
+while b[i] != 0:  # the attributes: name\0 type\0 i32 size, value; the header ends with \0
+    i = b.index(b"\0", b.index(b"\0", i) + 1) + 1
+    i += 4 + struct.unpack_from("<i", b, i)[0]
+table = i + 1
+chunk = struct.unpack_from("<Q", b, table)[0]
+short = bytes.fromhex("789c6360800100000a0001")  # zlib stream of 10 zero bytes
+open(f"{d}/repro_exr_short_zip_chunk.exr", "wb").write(b[:chunk + 4] + struct.pack("<i", len(short)) + short)
+open(f"{d}/repro_exr_chunk_offset_minus8.exr", "wb").write(b[:table] + struct.pack("<q", -8) + b[table + 8:])
+EOF
 
 # ---- mesh: decode_mesh ---------------------------------------------------------------------
 put mesh tetra.obj '# tetrahedron\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n'
@@ -95,6 +113,16 @@ put sketch bad_duplicate.json '{"domain": {"min": [0, 0, 0], "min": [1, 1, 1]}}'
 quiet "$st" field "$tmp/plane.json" -o "$out/field_file/plane.stf"
 quiet "$st" field "$tmp/surface.json" -o "$out/field_file/scaled.stf"
 quiet "$st" field "$tmp/frames.json" -o "$out/field_file/frames.stf"
+# Reproducer of the at(origin) finding (fuzz/README.md): plane.stf with node 0 = (1e200, 0, 0,
+# 1e200), whose squared norm overflows. Its checksum is stale; the harness also decodes it with
+# the checksum fixed (fuzz_support.h).
+python3 - "$out/field_file" <<'EOF'
+import struct, sys
+d = sys.argv[1]
+b = bytearray(open(f"{d}/plane.stf", "rb").read())
+struct.pack_into("<4d", b, 32 + 48, 1e200, 0.0, 0.0, 1e200)  # after the header, origin, spacing, dims, count
+open(f"{d}/repro_huge_quaternion.stf", "wb").write(bytes(b))
+EOF
 
 # ---- field_spec: first byte 0 "identity;scale:", 1 "quat:", 2 "axis:" -----------------------
 put field_spec identity_scale '\x001,2,0.5'

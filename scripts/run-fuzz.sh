@@ -9,7 +9,7 @@
 # Seeds come from fuzz/corpus/<harness>/ (read only); what the fuzzer discovers accumulates in
 # BUILD/corpus/<harness>/, so later runs start where earlier ones stopped. Logs: BUILD/logs/.
 # Environment: FUZZ_TIMEOUT (s per input, 10), FUZZ_RSS_MB (2048), FUZZ_ARGS (extra
-# libFuzzer flags, e.g. "-seed=1").
+# libFuzzer flags, e.g. "-seed=1"), FUZZ_SKIP (harnesses to leave out, e.g. "image mesh").
 set -uo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 if [ $# -lt 2 ]; then
@@ -24,6 +24,14 @@ if [ ${#harnesses[@]} -eq 0 ]; then
   for exe in "$build"/fuzz/fuzz_*; do
     [ -x "$exe" ] && harnesses+=("$(basename "$exe" | sed 's/^fuzz_//')")
   done
+fi
+if [ -n "${FUZZ_SKIP:-}" ]; then
+  kept=()
+  for h in "${harnesses[@]}"; do
+    case " $FUZZ_SKIP " in *" $h "*) echo "fuzz_$h: skipped (FUZZ_SKIP)";; *) kept+=("$h");; esac
+  done
+  if [ ${#kept[@]} -eq 0 ]; then echo "run-fuzz: every harness skipped"; exit 0; fi
+  harnesses=("${kept[@]}")
 fi
 if [ ${#harnesses[@]} -eq 0 ]; then
   echo "run-fuzz: no harnesses in $build/fuzz (configure with -DSOLIDTEX_FUZZ=ON and build the 'fuzzers' target)" >&2

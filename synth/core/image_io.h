@@ -2,7 +2,10 @@
 // OpenImageIO headers. Thread-safe (no shared state besides OIIO's own).
 //
 // Decoding contract:
-//  - PNG, JPEG, TIFF and OpenEXR, detected from the bytes (never from a file name);
+//  - PNG, JPEG, TIFF and OpenEXR, detected from the bytes (never from a file name), each read
+//    by that format's OIIO reader only (no other plugin is tried); a PNG whose chunks end
+//    before IEND is refused as truncated before libpng sees it; OpenEXR is read with the
+//    OpenEXR Core library (OIIO "openexr:core", set on the first decode);
 //  - 8/16-bit integer and half/float pixels; 1 (gray), 2 (gray+alpha), 3 (RGB), 4 (RGBA) channels;
 //  - the result is always 3-channel *linear* float RGB: integer images are taken as sRGB
 //    unless they declare a linear color space, float images as linear; gray is replicated,

@@ -3,6 +3,7 @@
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -126,6 +127,107 @@ TEST(ImageIo, RejectsEmptyGarbageAndTruncated) {
   EXPECT_FALSE(decode_image(jb).is_ok());
 
   EXPECT_EQ(load_image(tmp_path("does-not-exist.png")).status().code(), StatusCode::kNotFound);
+}
+
+TEST(ImageIo, RefusesPngsWhoseChunksEndEarly) {
+  const std::string path = tmp_path("chunks.png");
+  write_with_oiio(path, 16, 16, 3, OIIO::TypeDesc::UINT8);
+  const std::vector<uint8_t> png = file_bytes(path);
+  ASSERT_TRUE(decode_image(png).is_ok());
+  // Cut inside the last chunk (IEND), at a chunk boundary (no IEND), after the signature.
+  for (size_t keep : {png.size() - 1, png.size() - 12, size_t(8), size_t(20)}) {
+    std::vector<uint8_t> cut(png.begin(), png.begin() + keep);
+    auto r = decode_image(cut);
+    EXPECT_EQ(r.status().code(), StatusCode::kCorrupt) << keep;
+    EXPECT_NE(r.status().message().find("truncated PNG"), std::string::npos) << r.status().message();
+  }
+  // A chunk length beyond the PNG limit of 2^31 - 1.
+  std::vector<uint8_t> huge = png;
+  huge[8] = 0x80;
+  EXPECT_NE(decode_image(huge).status().message().find("chunk length"), std::string::npos);
+  // Bytes after IEND are not looked at.
+  std::vector<uint8_t> tail = png;
+  tail.insert(tail.end(), {1, 2, 3});
+  EXPECT_TRUE(decode_image(tail).is_ok());
+}
+
+// OpenEXR 3.1's classic reader takes a zip chunk that inflates to fewer bytes than its scanlines
+// need and returns the rest of its buffer (uninitialised heap memory) as pixels, with no
+// error; decode_image reads EXR with the OpenEXR Core library, which refuses the chunk.
+TEST(ImageIo, RefusesExrChunkThatInflatesShort) {
+  const std::string path = tmp_path("short_chunk.exr");
+  {
+    std::vector<float> px(8 * 12 * 3, 0.5f);
+    auto out = OIIO::ImageOutput::create(path);
+    ASSERT_TRUE(out);
+    OIIO::ImageSpec spec(8, 12, 3, OIIO::TypeDesc::HALF);
+    spec.attribute("compression", "zip");  // 16 scanlines per chunk: one chunk
+    ASSERT_TRUE(out->open(path, spec));
+    ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, px.data()));
+    out->close();
+  }
+  std::vector<uint8_t> exr = file_bytes(path);
+  ASSERT_TRUE(decode_image(exr).is_ok());
+  // Skip the magic and version, then the attributes (name\0 type\0 i32 size, data) up to the
+  // header's closing \0: the one-entry offset table follows, then the chunk (i32 y, i32 size).
+  size_t at = 8;
+  while (exr.at(at) != 0) {
+    at = size_t(std::find(exr.begin() + long(at), exr.end(), 0) - exr.begin()) + 1;  // name
+    at = size_t(std::find(exr.begin() + long(at), exr.end(), 0) - exr.begin()) + 1;  // type
+    int32_t size = 0;
+    std::memcpy(&size, &exr.at(at), 4);
+    at += 4 + size_t(size);
+  }
+  uint64_t chunk = 0;
+  std::memcpy(&chunk, &exr.at(at + 1), 8);
+  {
+    // An attribute that claims more bytes than the file has is refused before OpenEXR
+    // allocates them (the Core library allocates the declared size first).
+    std::vector<uint8_t> big = exr;
+    size_t size_at = 8;
+    for (int k = 0; k < 2; ++k) size_at = size_t(std::find(big.begin() + long(size_at), big.end(), 0) - big.begin()) + 1;
+    const uint32_t claim = 0x7fffff00u;
+    std::memcpy(&big[size_at], &claim, 4);
+    auto r = decode_image(big);
+    EXPECT_EQ(r.status().code(), StatusCode::kCorrupt);
+    EXPECT_NE(r.status().message().find("claims 2147483392 bytes"), std::string::npos) << r.status().to_string();
+  }
+  ASSERT_LT(chunk + 8, exr.size());
+  {
+    // A data window of 8 x 100000000 pixels is too large before OpenEXR allocates its chunk
+    // table (one entry per 16 of those lines).
+    std::vector<uint8_t> tall = exr;
+    const std::string key("dataWindow\0box2i\0", 17);
+    const auto it = std::search(tall.begin(), tall.end(), key.begin(), key.end());
+    ASSERT_NE(it, tall.end());
+    const size_t value = size_t(it - tall.begin()) + key.size() + 4;  // after the i32 size
+    const int32_t ymax = 99999999;
+    std::memcpy(&tall[value + 12], &ymax, 4);
+    auto r = decode_image(tall);
+    EXPECT_EQ(r.status().code(), StatusCode::kTooLarge) << r.status().to_string();
+    EXPECT_NE(r.status().message().find("8x100000000"), std::string::npos) << r.status().to_string();
+  }
+  {
+    // A chunk table entry of -8: OIIO's IOMemReader read the 8 bytes before the buffer (a
+    // heap-buffer-overflow under ASan, make test-sanitize); decode_image's reader reads nothing.
+    std::vector<uint8_t> before = exr;
+    const int64_t minus8 = -8;
+    std::memcpy(&before[at + 1], &minus8, 8);
+    auto r = decode_image(before);
+    ASSERT_FALSE(r.is_ok()) << "decoded";
+    EXPECT_EQ(r.status().code(), StatusCode::kCorrupt) << r.status().to_string();
+  }
+  // zlib's deflate of 10 zero bytes, where the chunk needs 8 x 12 x 3 halves (576 bytes).
+  const std::vector<uint8_t> short_zlib = {0x78, 0x9c, 0x63, 0x60, 0x80, 0x01, 0x00, 0x00, 0x0a, 0x00, 0x01};
+  exr.resize(chunk + 4);
+  const int32_t size = int32_t(short_zlib.size());
+  exr.insert(exr.end(), reinterpret_cast<const uint8_t*>(&size), reinterpret_cast<const uint8_t*>(&size) + 4);
+  exr.insert(exr.end(), short_zlib.begin(), short_zlib.end());
+  auto r = decode_image(exr);
+  ASSERT_FALSE(r.is_ok()) << "decoded";
+  EXPECT_EQ(r.status().code(), StatusCode::kCorrupt) << r.status().to_string();
+  // Refused by the reader, not (by chance) because the garbage held a non-finite value.
+  EXPECT_NE(r.status().message().find("pixel data cannot be decoded"), std::string::npos) << r.status().to_string();
 }
 
 TEST(ImageIo, RejectsAbsurdHeaderBeforeDecoding) {

@@ -1,6 +1,7 @@
 #include "field/field_file.h"
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 
 #include "core/byte_io.h"
@@ -11,6 +12,18 @@ namespace {
 constexpr char kMagic[8] = {'S', 'T', 'X', 'F', 'I', 'E', 'L', 'D'};
 constexpr uint32_t kHeader = 32;
 Status corrupt(const std::string& m) { return Status(StatusCode::kCorrupt, m, "field"); }
+// A stored value the writer cannot have produced (the checksum only proves the bytes are the
+// ones written): kCorrupt naming the value, e.g. field "field.spacing".
+Status bad_value(const std::string& item, const std::string& m) {
+  return Status(StatusCode::kCorrupt, m, "field." + item);
+}
+std::string number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+// The solver stores normalised quaternions (|q|^2 within a few ulp of 1).
+constexpr double kUnitTolerance = 1e-6;
 }  // namespace
 
 bool looks_like_field_file(std::span<const uint8_t> b) { return b.size() >= 8 && std::memcmp(b.data(), kMagic, 8) == 0; }
@@ -70,18 +83,36 @@ Result<StoredField> decode_field(std::span<const uint8_t> bytes) {
   SOLIDTEX_RETURN_IF_ERROR(r.f64(f.spacing));
   for (int& d : f.dims) SOLIDTEX_RETURN_IF_ERROR(r.i32(d));
   SOLIDTEX_RETURN_IF_ERROR(r.i32(f.singular_nodes));
+  // Everything a decoded field holds is what QuatGridField::create accepts, so a field file
+  // that decodes also loads.
+  if (!std::isfinite(f.origin.x) || !std::isfinite(f.origin.y) || !std::isfinite(f.origin.z))
+    return bad_value("origin", "stored origin (" + number(f.origin.x) + ", " + number(f.origin.y) + ", " +
+                                   number(f.origin.z) + ") is not finite");
+  if (!(f.spacing > 0) || !std::isfinite(f.spacing))
+    return bad_value("spacing", "stored spacing " + number(f.spacing) + " is not a finite number > 0");
   int64_t n = 1;
   for (int d : f.dims) {
-    if (d < 2 || d > 4096) return corrupt("impossible grid size");
+    if (d < 2 || d > kMaxGridSide)
+      return bad_value("dims", "stored grid size " + std::to_string(f.dims[0]) + "x" + std::to_string(f.dims[1]) + "x" +
+                                   std::to_string(f.dims[2]) + " is impossible (each side in [2, " +
+                                   std::to_string(kMaxGridSide) + "])");
     n *= d;
   }
+  if (f.singular_nodes < 0 || f.singular_nodes > n)
+    return bad_value("singular_nodes", "stored singular node count " + std::to_string(f.singular_nodes) +
+                                           " is outside [0, " + std::to_string(n) + "]");
   if (uint64_t(n) * 32 > r.remaining()) return corrupt("node data ends early");
   f.nodes.resize(size_t(n));
-  for (Quat& q : f.nodes) {
+  for (size_t i = 0; i < f.nodes.size(); ++i) {
+    Quat& q = f.nodes[i];
     SOLIDTEX_RETURN_IF_ERROR(r.f64(q.w));
     SOLIDTEX_RETURN_IF_ERROR(r.f64(q.x));
     SOLIDTEX_RETURN_IF_ERROR(r.f64(q.y));
     SOLIDTEX_RETURN_IF_ERROR(r.f64(q.z));
+    // Also refuses non-finite, zero and huge quaternions (|q|^2 overflows to infinity).
+    if (!(std::fabs(q.dot(q) - 1) <= kUnitTolerance))
+      return bad_value("nodes", "stored node " + std::to_string(i) + " (" + number(q.w) + ", " + number(q.x) + ", " +
+                                    number(q.y) + ", " + number(q.z) + ") is not a unit quaternion");
   }
   uint8_t has_scales = 0;
   SOLIDTEX_RETURN_IF_ERROR(r.u8(has_scales));
@@ -89,8 +120,14 @@ Result<StoredField> decode_field(std::span<const uint8_t> bytes) {
   if (has_scales) {
     if (uint64_t(n) * 24 > r.remaining()) return corrupt("scale data ends early");
     f.log_scales.resize(size_t(n));
-    for (auto& ls : f.log_scales)
-      for (double& v : ls) SOLIDTEX_RETURN_IF_ERROR(r.f64(v));
+    for (size_t i = 0; i < f.log_scales.size(); ++i)
+      for (double& v : f.log_scales[i]) {
+        SOLIDTEX_RETURN_IF_ERROR(r.f64(v));
+        // The same bounds as QuatGridField::create (the solver clamps to [log 0.25, log 4]).
+        if (!std::isfinite(v) || std::exp(v) < kMinScale * 0.999 || std::exp(v) > kMaxScale * 1.001)
+          return bad_value("log_scales", "stored log scale " + number(v) + " of node " + std::to_string(i) +
+                                             " is outside [log 0.25, log 4]");
+      }
   }
   uint64_t len = 0;
   SOLIDTEX_RETURN_IF_ERROR(r.u64(len));

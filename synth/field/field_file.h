@@ -5,6 +5,11 @@
 //            node quaternions (w, x, y, z as f64, x fastest), u8 has-scales and then per node
 //            three f64 log scales, then the sketch JSON (u64 length
 //            + UTF-8 bytes) so a stored field can be extended by more curves later.
+// decode_field refuses (kCorrupt, Status field "field" or "field.<value>") damaged files and
+// values the writer never produces: a non-finite origin, a spacing that is not finite and > 0,
+// sides outside [2, kMaxGridSide], a singular count outside [0, nodes], nodes that are not
+// unit quaternions, log scales outside [log 0.25, log 4]. What it accepts loads
+// (QuatGridField::create accepts it).
 #pragma once
 
 #include <memory>

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include "field/field_file.h"
 #include "core/number_list.h"
@@ -16,9 +17,21 @@
 namespace solidtex {
 
 Quat Quat::normalized() const {
-  const double n = std::sqrt(dot(*this));
-  if (!(n > 0)) return {};
-  return {w / n, x / n, y / n, z / n};
+  const double d = dot(*this);
+  // The common case: the squared norm is a normal finite number.
+  if (d >= std::numeric_limits<double>::min() && d <= std::numeric_limits<double>::max()) {
+    const double n = std::sqrt(d);
+    return {w / n, x / n, y / n, z / n};
+  }
+  // Components beyond ~1.3e154 overflow the squared norm to infinity (dividing by it gave the
+  // zero quaternion, which callers then read as the identity), components below ~1e-154
+  // underflow it: scale by the largest component first. Non-finite or zero: the identity.
+  if (!std::isfinite(w) || !std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) return {};
+  const double m = std::max({std::fabs(w), std::fabs(x), std::fabs(y), std::fabs(z)});
+  if (!(m > 0)) return {};
+  const Quat s{w / m, x / m, y / m, z / m};
+  const double n = std::sqrt(s.dot(s));
+  return {s.w / n, s.x / n, s.y / n, s.z / n};
 }
 
 Quat Quat::from_axis_angle(double ax, double ay, double az, double radians) {
@@ -73,7 +86,8 @@ Result<std::shared_ptr<const QuatGridField>> QuatGridField::create(WorldPoint or
   if (!std::isfinite(origin.x) || !std::isfinite(origin.y) || !std::isfinite(origin.z))
     return Status(StatusCode::kInvalidArgument, "must be finite", "origin");
   for (int d : dims)
-    if (d < 2 || d > 1024) return Status(StatusCode::kInvalidArgument, "each must be in [2, 1024]", "dims");
+    if (d < 2 || d > kMaxGridSide)
+      return Status(StatusCode::kInvalidArgument, "each must be in [2, " + std::to_string(kMaxGridSide) + "]", "dims");
   if (values.size() != size_t(dims[0]) * dims[1] * dims[2])
     return Status(StatusCode::kInvalidArgument,
                   "has " + std::to_string(values.size()) + " entries; dims need " +

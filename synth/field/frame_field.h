@@ -18,6 +18,8 @@ namespace solidtex {
 struct Quat {
   double w = 1, x = 0, y = 0, z = 0;
   double dot(const Quat& o) const { return w * o.w + x * o.x + y * o.y + z * o.z; }
+  // Unit length (to rounding) for any finite non-zero components, however large or small (the
+  // squared norm does not overflow); the identity for zero and for non-finite components.
   Quat normalized() const;
   Quat conjugate() const { return {w, -x, -y, -z}; }
   static Quat from_axis_angle(double ax, double ay, double az, double radians);
@@ -95,6 +97,8 @@ class QuatGridField : public FrameField {
 };
 
 inline constexpr double kMinScale = 0.25, kMaxScale = 4.0;
+// The most nodes a QuatGridField (and so a .stf file) has along one axis.
+inline constexpr int kMaxGridSide = 1024;
 
 // "identity", "quat:W,X,Y,Z", "axis:AX,AY,AZ,DEGREES", optionally followed by
 // ";scale:SX,SY,SZ" (constant per-axis scale), or a path to a JSON quaternion grid

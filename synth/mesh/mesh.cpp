@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <numeric>
 #include <unordered_map>
@@ -37,6 +38,15 @@ Result<Placement> fit_placement(const MeshBounds& bounds, int resolution, double
   Placement p;
   p.scale = resolution / (longest * (1 + 2 * margin));
   for (int a = 0; a < 3; ++a) p.translate[size_t(a)] = -p.scale * (bounds.min[size_t(a)] - margin * longest);
+  // A (denormal) extent like 5e-324 overflows the scale; a tiny extent far from the origin,
+  // the translation.
+  if (!std::isfinite(p.scale) || !std::isfinite(p.translate[0]) || !std::isfinite(p.translate[1]) ||
+      !std::isfinite(p.translate[2])) {
+    char extent[32];
+    std::snprintf(extent, sizeof extent, "%.3g", longest);
+    return Status(StatusCode::kUnprocessable,
+                  std::string("the mesh's extent (") + extent + " along its longest side) is too small to fit", "mesh");
+  }
   return p;
 }
 

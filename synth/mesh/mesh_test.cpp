@@ -160,6 +160,25 @@ TEST(Mesh, PlacementFitsTheEnlargedBoxToTheResolution) {
   EXPECT_FALSE(fit_placement(b, 4, 0.25).is_ok());
 }
 
+// fuzz/crashes/mesh-denormal-extent.obj: a triangle 5e-324 wide gave an infinite scale.
+TEST(Mesh, PlacementRefusesExtentsTooSmallToScale) {
+  for (const MeshBounds& b : {MeshBounds{{0, 0, 0}, {5e-324, 5e-324, 0}}, MeshBounds{{1e300, 0, 0}, {1e300, 1e-300, 0}}}) {
+    auto p = fit_placement(b, 512, 0.25);
+    ASSERT_FALSE(p.is_ok()) << p->scale;
+    EXPECT_EQ(p.status().code(), StatusCode::kUnprocessable);
+    EXPECT_EQ(p.status().field(), "mesh");
+  }
+  EXPECT_NE(fit_placement(MeshBounds{{0, 0, 0}, {5e-324, 0, 0}}, 512, 0.25).status().message().find("(4.94e-324 "),
+            std::string::npos);
+  // The decoded mesh of the finding.
+  const std::string obj = "v 0 0 0\nv 5e-324 0 0\nv 0 5e-324 0\nf 1 2 3\n";
+  auto m = decode_mesh(std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(obj.data()), obj.size()));
+  ASSERT_TRUE(m.is_ok()) << m.status().to_string();
+  EXPECT_EQ(fit_placement(m->bounds(), 512, 0.25).status().code(), StatusCode::kUnprocessable);
+  // Small but ordinary extents still fit.
+  EXPECT_TRUE(fit_placement(MeshBounds{{0, 0, 0}, {1e-200, 0, 0}}, 512, 0.25).is_ok());
+}
+
 // Frame axis k (column k of the rotation) of a quaternion.
 std::array<double, 3> axis_of(const Quat& q, int k) {
   const Rot3 r = Rot3::from_quat(q);
