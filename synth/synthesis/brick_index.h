@@ -53,6 +53,10 @@ class BrickIndex {
     const size_t by = rest % size_t(bn_[1]), bz = rest / size_t(bn_[1]);
     return {(b0_[0] + int(bx)) * kSide, (b0_[1] + int(by)) * kSide, (b0_[2] + int(bz)) * kSide};
   }
+  // Brick coordinates (voxel / 8) of the cover's lowest brick, and the cover's extent in
+  // bricks per axis; brick number = (z * extent[1] + y) * extent[0] + x, relative to first.
+  const std::array<int, 3>& first_brick() const { return b0_; }
+  const std::array<int, 3>& extent() const { return bn_; }
   // Position of p inside its brick, in [0, kVoxels): x fastest.
   static int voxel_in_brick(const Voxel& p) { return (p.x & 7) + 8 * (p.y & 7) + 64 * (p.z & 7); }
   // Inverse of voxel_in_brick for a brick's origin.

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cstdlib>
 
 namespace solidtex {
 namespace {
@@ -65,6 +66,253 @@ Result<int64_t> step_back(const FrameStencils& stencils, PyramidLevel l, const C
   return updated.load();
 }
 
+// ---- Brick-level step, for stencils that are the same at every voxel of the level ----
+//
+// The per-voxel step marks (p + o, H(p, o)) for every updated p and offset o. With one offset
+// list for the whole level, the marks of offset o are the updated set shifted by o, split by
+// version: H(p, o) = min(latest, barrier versions of the barriers whose cell p + o leaves).
+// "p + o stays in p's cell" is per axis a condition on p's coordinate, so the voxels of a
+// destination brick reading a given version form a product of three 8-bit masks. Each
+// destination brick gathers its bits from the (at most 8) source bricks under it, so each brick
+// of every set is written by one task: no atomics, and the same sets as the per-voxel path.
+
+using Bits = VoxelMask::Bits;
+
+// Every row (byte) of a z-slice word with its low k bits set, 0 <= k <= 8.
+constexpr uint64_t low_rows(int k) {
+  return k >= 8 ? ~uint64_t(0) : uint64_t(0x0101010101010101ull) * ((uint64_t(1) << k) - 1);
+}
+
+// The brick mask {x in mx, y in my, z in mz}.
+Bits product_mask(uint8_t mx, uint8_t my, uint8_t mz) {
+  uint64_t slice = 0;
+  for (int y = 0; y < 8; ++y)
+    if ((my >> y) & 1) slice |= uint64_t(mx) << (8 * y);
+  Bits b;
+  for (int z = 0; z < 8; ++z) b[size_t(z)] = ((mz >> z) & 1) ? slice : 0;
+  return b;
+}
+
+// Offset o as a brick shift: destination voxel t reads source t - o, i.e. `brick` whole
+// bricks plus `rest` voxels (0..7) on each axis.
+struct ShiftPlan {
+  std::array<int, 3> o{}, brick{}, rest{};
+  uint64_t keep_lo = 0, keep_hi = 0;  // x bits taken from the lower / upper source brick
+};
+
+// Dense brick coordinates: the level's brick cover with a margin of 2m bricks on every side,
+// so that every destination brick (cover + m) and its sources (destination + [-m, m]) exist.
+struct BrickGrid {
+  std::array<int, 3> first{}, cover{}, n{};
+  int pad = 0;
+  size_t at(int x, int y, int z) const { return (size_t(z) * size_t(n[1]) + size_t(y)) * size_t(n[0]) + size_t(x); }
+  size_t size() const { return size_t(n[0]) * size_t(n[1]) * size_t(n[2]); }
+};
+
+// Destination brick (grid coordinates) shifted-gathered for one offset.
+Bits gather(const std::vector<const Bits*>& src, const BrickGrid& g, int X, int Y, int Z, const ShiftPlan& s) {
+  const int x0 = X + s.brick[0], y0 = Y + s.brick[1], z0 = Z + s.brick[2];
+  const int rx = s.rest[0], ry = s.rest[1], rz = s.rest[2];
+  Bits out;
+  for (int tz = 0; tz < 8; ++tz) {
+    const int sz = tz + rz;
+    const int zb = z0 + (sz >> 3);
+    const size_t wz = size_t(sz & 7);
+    const Bits& a = *src[g.at(x0, y0, zb)];
+    const Bits& c = *src[g.at(x0 + 1, y0, zb)];
+    uint64_t lo = a[wz] >> (8 * ry), hi = c[wz] >> (8 * ry);
+    if (ry) {
+      lo |= (*src[g.at(x0, y0 + 1, zb)])[wz] << (64 - 8 * ry);
+      hi |= (*src[g.at(x0 + 1, y0 + 1, zb)])[wz] << (64 - 8 * ry);
+    }
+    uint64_t w = (lo >> rx) & s.keep_lo;
+    if (rx) w |= (hi << (8 - rx)) & s.keep_hi;
+    out[size_t(tz)] = w;
+  }
+  return out;
+}
+
+Result<int64_t> brick_step_back(const FrameStencils::Offsets& offsets, const CorrectionStep& step,
+                                LevelDependencies& dep, int v, LatchedInterrupter& interrupter) {
+  static const Bits kZero{};
+  const VoxelMask& cur = dep.needed[size_t(v)];
+  const BrickIndex& index = cur.index();
+  int reach = 0;
+  for (const auto& o : offsets)
+    for (int a = 0; a < 3; ++a) reach = std::max(reach, std::abs(int(o[size_t(a)])));
+  const int m = (reach + 7) / 8 + 1;
+  BrickGrid g;
+  g.first = index.first_brick();
+  g.cover = index.extent();
+  g.pad = 2 * m;
+  for (int a = 0; a < 3; ++a) g.n[size_t(a)] = g.cover[size_t(a)] + 4 * m;
+
+  // The update class as a brick pattern: it depends on coordinates mod s, and s divides 8
+  // (checked by the caller), so every brick has the same pattern.
+  Bits updates{};
+  for (int bit = 0; bit < BrickIndex::kVoxels; ++bit)
+    if (step.updates.contains(BrickIndex::voxel_at({0, 0, 0}, bit))) updates[size_t(bit >> 6)] |= uint64_t(1) << (bit & 63);
+
+  // Sources (updated members) and carries (members the step leaves alone), per cover brick.
+  std::vector<const Bits*> src(g.size(), &kZero);
+  std::vector<int32_t> carry_of(g.size(), -1);
+  std::vector<Bits> sources, carries;
+  sources.reserve(size_t(cur.bricks()));
+  carries.reserve(size_t(cur.bricks()));
+  std::vector<uint8_t> candidate(g.size(), 0);
+  int dlo[3], dhi[3];
+  {
+    int omin[3] = {0, 0, 0}, omax[3] = {0, 0, 0};
+    for (const auto& o : offsets)
+      for (int a = 0; a < 3; ++a) {
+        omin[a] = std::min(omin[a], int(o[size_t(a)]));
+        omax[a] = std::max(omax[a], int(o[size_t(a)]));
+      }
+    for (int a = 0; a < 3; ++a) {
+      dlo[a] = floor_div(omin[a], 8);
+      dhi[a] = floor_div(7 + omax[a], 8);
+    }
+  }
+  int64_t updated = 0;
+  Bits s;
+  for (size_t b = 0; b < index.size(); ++b) {
+    if (!cur.bits(b, s)) continue;
+    const int cx = int(b % size_t(g.cover[0])), cy = int(b / size_t(g.cover[0]) % size_t(g.cover[1])),
+              cz = int(b / (size_t(g.cover[0]) * size_t(g.cover[1])));
+    const int X = cx + g.pad, Y = cy + g.pad, Z = cz + g.pad;
+    Bits a, c;
+    uint64_t any_a = 0, any_c = 0;
+    for (size_t w = 0; w < 8; ++w) {
+      a[w] = s[w] & updates[w];
+      c[w] = s[w] & ~updates[w];
+      any_a |= a[w];
+      any_c |= c[w];
+      updated += __builtin_popcountll(a[w]);
+    }
+    if (any_c) {
+      carry_of[g.at(X, Y, Z)] = int32_t(carries.size());
+      carries.push_back(c);
+      candidate[g.at(X, Y, Z)] = 1;
+    }
+    if (any_a) {
+      sources.push_back(a);
+      src[g.at(X, Y, Z)] = &sources.back();
+      for (int z = Z + dlo[2]; z <= Z + dhi[2]; ++z)
+        for (int y = Y + dlo[1]; y <= Y + dhi[1]; ++y)
+          for (int x = X + dlo[0]; x <= X + dhi[0]; ++x) candidate[g.at(x, y, z)] = 1;
+    }
+  }
+  std::vector<std::array<int, 3>> dests;
+  for (int z = 0; z < g.n[2]; ++z)
+    for (int y = 0; y < g.n[1]; ++y)
+      for (int x = 0; x < g.n[0]; ++x)
+        if (candidate[g.at(x, y, z)]) dests.push_back({x, y, z});
+
+  std::vector<ShiftPlan> plans;
+  plans.reserve(offsets.size());
+  for (const auto& o : offsets) {
+    ShiftPlan p;
+    for (int a = 0; a < 3; ++a) {
+      p.o[size_t(a)] = o[size_t(a)];
+      p.brick[size_t(a)] = floor_div(-int(o[size_t(a)]), 8);
+      p.rest[size_t(a)] = -int(o[size_t(a)]) - 8 * p.brick[size_t(a)];
+    }
+    p.keep_lo = low_rows(8 - p.rest[0]);
+    p.keep_hi = ~p.keep_lo;
+    plans.push_back(p);
+  }
+
+  // The window's versions (the same for every voxel) and, per barrier, axis, destination brick
+  // coordinate and offset component, which destination voxels stay in their source's cell.
+  const HistoryWindow::Resolved any = step.window.resolve({0, 0, 0});
+  const int nb = std::clamp(any.count, 0, 4);
+  std::array<int, 4> order{0, 1, 2, 3};
+  std::sort(order.begin(), order.begin() + nb,
+            [&](int i, int j) { return any.barrier_version[size_t(i)] < any.barrier_version[size_t(j)]; });
+  const int W = 2 * reach + 1;
+  // incell[k][a][G * W + o + reach]
+  std::vector<std::array<std::vector<uint8_t>, 3>> incell{size_t(nb)};
+  for (int k = 0; k < nb; ++k)
+    for (int a = 0; a < 3; ++a) {
+      std::vector<uint8_t>& t = incell[size_t(k)][size_t(a)];
+      t.assign(size_t(g.n[size_t(a)]) * size_t(W), 0);
+      for (int G = 0; G < g.n[size_t(a)]; ++G)
+        for (int oa = -reach; oa <= reach; ++oa) {
+          uint8_t mask = 0;
+          for (int tt = 0; tt < 8; ++tt) {
+            const int q = (G - g.pad + g.first[size_t(a)]) * 8 + tt;  // destination coordinate
+            const int p = q - oa;                                      // the reader's
+            const HistoryWindow::Resolved r = step.window.resolve({p, p, p});
+            const int lo = a == 0 ? r.lo[size_t(k)].x : a == 1 ? r.lo[size_t(k)].y : r.lo[size_t(k)].z;
+            const int hi = a == 0 ? r.hi[size_t(k)].x : a == 1 ? r.hi[size_t(k)].y : r.hi[size_t(k)].z;
+            if (q >= lo && q < hi) mask = uint8_t(mask | (1u << tt));
+          }
+          t[size_t(G) * size_t(W) + size_t(oa + reach)] = mask;
+        }
+    }
+  std::array<std::vector<uint8_t>, 3> inbox;
+  const std::array<int, 3> blo{dep.box.lo.x, dep.box.lo.y, dep.box.lo.z}, bhi{dep.box.hi.x, dep.box.hi.y, dep.box.hi.z};
+  for (int a = 0; a < 3; ++a) {
+    inbox[size_t(a)].assign(size_t(g.n[size_t(a)]), 0);
+    for (int G = 0; G < g.n[size_t(a)]; ++G)
+      for (int tt = 0; tt < 8; ++tt) {
+        const int q = (G - g.pad + g.first[size_t(a)]) * 8 + tt;
+        if (q >= blo[size_t(a)] && q < bhi[size_t(a)]) inbox[size_t(a)][size_t(G)] |= uint8_t(1u << tt);
+      }
+  }
+
+  // Accumulator slots: 0 = latest, 1 + j = the j-th lowest barrier version, nb + 1 = carry.
+  std::array<int, 6> slot_version{};
+  slot_version[0] = any.latest;
+  for (int j = 0; j < nb; ++j) slot_version[size_t(1 + j)] = any.barrier_version[size_t(order[size_t(j)])];
+  slot_version[size_t(nb + 1)] = v - 1;
+
+  std::atomic<bool> escaped{false};
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, dests.size(), 16), [&](const tbb::blocked_range<size_t>& r) {
+    if (interrupter.poll()) return;
+    for (size_t i = r.begin(); i != r.end(); ++i) {
+      const auto [X, Y, Z] = dests[i];
+      std::array<Bits, 6> acc{};
+      for (const ShiftPlan& p : plans) {
+        Bits rem = gather(src, g, X, Y, Z, p);
+        uint64_t any_bit = 0;
+        for (uint64_t w : rem) any_bit |= w;
+        if (!any_bit) continue;
+        for (int j = 0; j < nb; ++j) {
+          const int k = order[size_t(j)];
+          if (slot_version[size_t(1 + j)] >= any.latest) break;  // min() keeps the latest
+          const auto& t = incell[size_t(k)];
+          const Bits in = product_mask(t[0][size_t(X) * size_t(W) + size_t(p.o[0] + reach)],
+                                       t[1][size_t(Y) * size_t(W) + size_t(p.o[1] + reach)],
+                                       t[2][size_t(Z) * size_t(W) + size_t(p.o[2] + reach)]);
+          for (size_t w = 0; w < 8; ++w) {
+            acc[size_t(1 + j)][w] |= rem[w] & ~in[w];
+            rem[w] &= in[w];
+          }
+        }
+        for (size_t w = 0; w < 8; ++w) acc[0][w] |= rem[w];
+      }
+      const int32_t ci = carry_of[g.at(X, Y, Z)];
+      if (ci >= 0) acc[size_t(nb + 1)] = carries[size_t(ci)];
+      const int cx = X - g.pad, cy = Y - g.pad, cz = Z - g.pad;
+      const bool in_cover = cx >= 0 && cy >= 0 && cz >= 0 && cx < g.cover[0] && cy < g.cover[1] && cz < g.cover[2];
+      const Bits box = product_mask(inbox[0][size_t(X)], inbox[1][size_t(Y)], inbox[2][size_t(Z)]);
+      const size_t b = in_cover ? (size_t(cz) * size_t(g.cover[1]) + size_t(cy)) * size_t(g.cover[0]) + size_t(cx) : 0;
+      for (int k = 0; k < nb + 2; ++k) {
+        Bits& bits = acc[size_t(k)];
+        for (size_t w = 0; w < 8; ++w) {
+          if (bits[w] & ~box[w]) escaped = true;
+          bits[w] &= box[w];
+        }
+        if (in_cover) dep.needed[size_t(slot_version[size_t(k)])].or_bits(b, bits);
+      }
+    }
+  });
+  if (interrupter.stopped()) return Status(StatusCode::kCancelled, "synthesis cancelled");
+  if (escaped) return Status(StatusCode::kInternal, "dependency escaped its bounding box (stencil reach too small)");
+  return updated;
+}
+
 std::vector<Voxel> parents_of(const VoxelMask& set) {
   std::vector<Voxel> parents;
   parents.reserve(size_t(set.count()) / 4 + 1);
@@ -108,8 +356,17 @@ Result<std::vector<LevelDependencies>> analyze_dependencies(const DependencyInpu
     take_cached(in.cache, PyramidLevel{l}, final_need, dep, dep.needed[size_t(V)]);
     for (int v = V; v >= 1; --v) {
       if (interrupter.poll()) return Status(StatusCode::kCancelled, "synthesis cancelled");
-      SOLIDTEX_ASSIGN_OR_RETURN(const int64_t updates,
-                                step_back(*in.stencils, PyramidLevel{l}, sch.steps()[size_t(v - 1)], dep, v, interrupter));
+      const CorrectionStep& step = sch.steps()[size_t(v - 1)];
+      // The brick path needs one offset list for the level and an update class that repeats
+      // with every brick; anything else takes the per-voxel path.
+      const bool by_brick = !in.per_voxel && in.stencils->constant() && 8 % step.updates.s == 0;
+      ReadStencil st;
+      FrameStencils::Offsets scratch;
+      SOLIDTEX_ASSIGN_OR_RETURN(
+          const int64_t updates,
+          by_brick ? brick_step_back(in.stencils->offsets(PyramidLevel{l}, {0, 0, 0}, st, scratch), step, dep, v,
+                                     interrupter)
+                   : step_back(*in.stencils, PyramidLevel{l}, step, dep, v, interrupter));
       dep.corrections += updates;
     }
     if (l > 0) final_need = parents_of(dep.needed[0]);

@@ -10,6 +10,11 @@
 // Soundness (every read lies in a set) and tightness (every member is read) are checked by the
 // synthesizer's instrumented mode. The sets never depend on thread count or order: set union
 // is order-independent and VoxelMask iterates in a fixed order.
+// Two paths compute the same sets: when the field is constant (one stencil per level,
+// FrameStencils::constant()), each step dilates the set brick by brick (512-bit shifts per
+// stencil offset, split by the history window's versions, each destination brick written by one
+// task); otherwise each member voxel inserts its own stencil. Both give bit-identical sets and
+// counts (dependency_test.cpp).
 // Bounds: level l's sets lie in `box`, the final-version box dilated by the schedule's steps
 // times the stencil reach; a read outside it is an internal error (stencil reach too small).
 #pragma once
@@ -40,6 +45,7 @@ struct DependencyInputs {
   const std::vector<LevelSchedule>* schedules = nullptr;  // per level
   const FrameStencils* stencils = nullptr;
   VoxelCache* cache = nullptr;  // null: consult no cache
+  bool per_voxel = false;       // force the per-voxel path (the reference, for tests/benchmarks)
 };
 
 // The per-level sets for `target` (index = level, coarsest first). Cancelled through

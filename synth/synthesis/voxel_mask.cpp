@@ -62,6 +62,33 @@ bool VoxelMask::contains(const Voxel& p) const {
   return ((*brick_at(idx))[size_t(bit >> 6)].load(std::memory_order_relaxed) >> (bit & 63)) & 1;
 }
 
+bool VoxelMask::bits(size_t b, Bits& out) const {
+  const int32_t idx = table_size_ ? table_[b].load(std::memory_order_acquire) : -1;
+  if (idx < 0) {
+    out.fill(0);
+    return false;
+  }
+  const Brick& br = *brick_at(idx);
+  for (size_t w = 0; w < 8; ++w) out[w] = br[w].load(std::memory_order_relaxed);
+  return true;
+}
+
+void VoxelMask::or_bits(size_t b, const Bits& add) {
+  uint64_t any = 0;
+  for (uint64_t w : add) any |= w;
+  if (!any) return;
+  int32_t idx = table_[b].load(std::memory_order_acquire);
+  if (idx < 0) idx = allocate_brick(b);
+  Brick& br = *brick_at(idx);
+  int64_t added = 0;
+  for (size_t w = 0; w < 8; ++w) {
+    const uint64_t old = br[w].load(std::memory_order_relaxed);
+    br[w].store(old | add[w], std::memory_order_relaxed);  // one writer per brick: no read-modify-write
+    added += __builtin_popcountll(add[w] & ~old);
+  }
+  count_.fetch_add(added, std::memory_order_relaxed);
+}
+
 std::vector<Voxel> VoxelMask::to_vector() const {
   std::vector<Voxel> out;
   out.reserve(size_t(count()));

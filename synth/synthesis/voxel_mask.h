@@ -3,6 +3,8 @@
 // hashing; iteration is in a fixed (brick, then bit) order whatever the insertion order, so
 // anything derived from a mask is deterministic. insert() is thread-safe (atomic bit-or, brick
 // allocation under a lock); contains()/to_vector() must not race with inserts.
+// Whole-brick access (bits/or_bits) serves the brick-level dependency path: or_bits() calls
+// on distinct bricks may run concurrently; on one brick, or together with insert(), they may not.
 #pragma once
 
 #include <array>
@@ -30,6 +32,15 @@ class VoxelMask {
   int64_t count() const { return count_.load(std::memory_order_relaxed); }
   int64_t bricks() const { return bricks_; }  // allocated bricks (not thread-safe with inserts)
   std::vector<Voxel> to_vector() const;
+
+  // 512 bits of one brick, bit x + 8y + 64z relative to the brick origin (brick_index.h).
+  using Bits = std::array<uint64_t, 8>;
+  const BrickIndex& index() const { return index_; }
+  // The bits of brick number b (< index().size()); false (and zeros) when it was never allocated.
+  bool bits(size_t b, Bits& out) const;
+  // ORs `add` into brick b, allocating it only when `add` has a bit set (so bricks() stays the
+  // count of non-empty bricks, as with insert()).
+  void or_bits(size_t b, const Bits& add);
 
  private:
   using Brick = std::array<std::atomic<uint64_t>, 8>;  // 512 bits: bit (x + 8y + 64z)
