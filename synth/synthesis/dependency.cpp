@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <atomic>
 #include <cstdlib>
+#include <map>
+#include <utility>
 
 namespace solidtex {
 namespace {
@@ -109,27 +111,30 @@ struct BrickGrid {
   size_t size() const { return size_t(n[0]) * size_t(n[1]) * size_t(n[2]); }
 };
 
-// Destination brick (grid coordinates) shifted-gathered for one offset.
-Bits gather(const std::vector<const Bits*>& src, const BrickGrid& g, int X, int Y, int Z, const ShiftPlan& s) {
-  const int x0 = X + s.brick[0], y0 = Y + s.brick[1], z0 = Z + s.brick[2];
-  const int rx = s.rest[0], ry = s.rest[1], rz = s.rest[2];
-  Bits out;
+// Offsets sharing (dy, dz) share the y/z part of the shift: it is gathered once per x brick
+// (y/z-shifted slices), and each member then shifts along x only.
+struct ShiftGroup {
+  int y_brick = 0, z_brick = 0, ry = 0, rz = 0;
+  int xb_lo = 0, xb_hi = 0;  // x bricks the members read: their x brick shifts, plus one for the spill
+  std::vector<size_t> members;  // into the plans
+};
+
+// The y/z-shifted slices of the source bricks at grid x = x for destination (Y, Z); returns
+// the OR of all words (0: nothing to shift).
+uint64_t gather_yz(const std::vector<const Bits*>& src, const BrickGrid& g, int x, int Y, int Z, const ShiftGroup& gr,
+                   Bits& out) {
+  const int y0 = Y + gr.y_brick, z0 = Z + gr.z_brick;
+  uint64_t any = 0;
   for (int tz = 0; tz < 8; ++tz) {
-    const int sz = tz + rz;
+    const int sz = tz + gr.rz;
     const int zb = z0 + (sz >> 3);
     const size_t wz = size_t(sz & 7);
-    const Bits& a = *src[g.at(x0, y0, zb)];
-    const Bits& c = *src[g.at(x0 + 1, y0, zb)];
-    uint64_t lo = a[wz] >> (8 * ry), hi = c[wz] >> (8 * ry);
-    if (ry) {
-      lo |= (*src[g.at(x0, y0 + 1, zb)])[wz] << (64 - 8 * ry);
-      hi |= (*src[g.at(x0 + 1, y0 + 1, zb)])[wz] << (64 - 8 * ry);
-    }
-    uint64_t w = (lo >> rx) & s.keep_lo;
-    if (rx) w |= (hi << (8 - rx)) & s.keep_hi;
+    uint64_t w = (*src[g.at(x, y0, zb)])[wz] >> (8 * gr.ry);
+    if (gr.ry) w |= (*src[g.at(x, y0 + 1, zb)])[wz] << (64 - 8 * gr.ry);
     out[size_t(tz)] = w;
+    any |= w;
   }
-  return out;
+  return any;
 }
 
 Result<int64_t> brick_step_back(const FrameStencils::Offsets& offsets, const CorrectionStep& step,
@@ -221,6 +226,29 @@ Result<int64_t> brick_step_back(const FrameStencils::Offsets& offsets, const Cor
     p.keep_hi = ~p.keep_lo;
     plans.push_back(p);
   }
+  std::map<std::pair<int, int>, ShiftGroup> by_yz;
+  for (size_t i = 0; i < plans.size(); ++i) {
+    const ShiftPlan& p = plans[i];
+    auto [it, fresh] = by_yz.try_emplace({p.o[1], p.o[2]});
+    ShiftGroup& gr = it->second;
+    if (fresh) {
+      gr.y_brick = p.brick[1];
+      gr.z_brick = p.brick[2];
+      gr.ry = p.rest[1];
+      gr.rz = p.rest[2];
+      gr.xb_lo = p.brick[0];
+      gr.xb_hi = p.brick[0] + 1;
+    }
+    gr.xb_lo = std::min(gr.xb_lo, p.brick[0]);
+    gr.xb_hi = std::max(gr.xb_hi, p.brick[0] + 1);
+    gr.members.push_back(i);
+  }
+  std::vector<ShiftGroup> groups;
+  size_t widest = 0;
+  for (auto& [key, gr] : by_yz) {
+    widest = std::max(widest, size_t(gr.xb_hi - gr.xb_lo + 1));
+    groups.push_back(std::move(gr));
+  }
 
   // The window's versions (the same for every voxel) and, per barrier, axis, destination brick
   // coordinate and offset component, which destination voxels stay in their source's cell.
@@ -270,27 +298,43 @@ Result<int64_t> brick_step_back(const FrameStencils::Offsets& offsets, const Cor
   std::atomic<bool> escaped{false};
   tbb::parallel_for(tbb::blocked_range<size_t>(0, dests.size(), 16), [&](const tbb::blocked_range<size_t>& r) {
     if (interrupter.poll()) return;
+    std::vector<Bits> yz(widest);
     for (size_t i = r.begin(); i != r.end(); ++i) {
       const auto [X, Y, Z] = dests[i];
       std::array<Bits, 6> acc{};
-      for (const ShiftPlan& p : plans) {
-        Bits rem = gather(src, g, X, Y, Z, p);
-        uint64_t any_bit = 0;
-        for (uint64_t w : rem) any_bit |= w;
-        if (!any_bit) continue;
-        for (int j = 0; j < nb; ++j) {
-          const int k = order[size_t(j)];
-          if (slot_version[size_t(1 + j)] >= any.latest) break;  // min() keeps the latest
-          const auto& t = incell[size_t(k)];
-          const Bits in = product_mask(t[0][size_t(X) * size_t(W) + size_t(p.o[0] + reach)],
-                                       t[1][size_t(Y) * size_t(W) + size_t(p.o[1] + reach)],
-                                       t[2][size_t(Z) * size_t(W) + size_t(p.o[2] + reach)]);
+      for (const ShiftGroup& gr : groups) {
+        uint64_t any_group = 0;
+        for (int xb = gr.xb_lo; xb <= gr.xb_hi; ++xb)
+          any_group |= gather_yz(src, g, X + xb, Y, Z, gr, yz[size_t(xb - gr.xb_lo)]);
+        if (!any_group) continue;
+        for (const size_t pi : gr.members) {
+          const ShiftPlan& p = plans[pi];
+          const Bits& lo = yz[size_t(p.brick[0] - gr.xb_lo)];
+          const Bits& hi = yz[size_t(p.brick[0] - gr.xb_lo + 1)];
+          const int rx = p.rest[0];
+          Bits rem;
+          uint64_t any_bit = 0;
           for (size_t w = 0; w < 8; ++w) {
-            acc[size_t(1 + j)][w] |= rem[w] & ~in[w];
-            rem[w] &= in[w];
+            uint64_t bits = (lo[w] >> rx) & p.keep_lo;
+            if (rx) bits |= (hi[w] << (8 - rx)) & p.keep_hi;
+            rem[w] = bits;
+            any_bit |= bits;
           }
+          if (!any_bit) continue;
+          for (int j = 0; j < nb; ++j) {
+            const int k = order[size_t(j)];
+            if (slot_version[size_t(1 + j)] >= any.latest) break;  // min() keeps the latest
+            const auto& t = incell[size_t(k)];
+            const Bits in = product_mask(t[0][size_t(X) * size_t(W) + size_t(p.o[0] + reach)],
+                                         t[1][size_t(Y) * size_t(W) + size_t(p.o[1] + reach)],
+                                         t[2][size_t(Z) * size_t(W) + size_t(p.o[2] + reach)]);
+            for (size_t w = 0; w < 8; ++w) {
+              acc[size_t(1 + j)][w] |= rem[w] & ~in[w];
+              rem[w] &= in[w];
+            }
+          }
+          for (size_t w = 0; w < 8; ++w) acc[0][w] |= rem[w];
         }
-        for (size_t w = 0; w < 8; ++w) acc[0][w] |= rem[w];
       }
       const int32_t ci = carry_of[g.at(X, Y, Z)];
       if (ci >= 0) acc[size_t(nb + 1)] = carries[size_t(ci)];
@@ -313,13 +357,31 @@ Result<int64_t> brick_step_back(const FrameStencils::Offsets& offsets, const Cor
   return updated;
 }
 
-std::vector<Voxel> parents_of(const VoxelMask& set) {
-  std::vector<Voxel> parents;
-  parents.reserve(size_t(set.count()) / 4 + 1);
-  for (const Voxel& p : set.to_vector()) parents.push_back(parent_of(p));
-  std::sort(parents.begin(), parents.end());
-  parents.erase(std::unique(parents.begin(), parents.end()), parents.end());
-  return parents;
+// The distinct parents of a set's voxels, sorted, found brick by brick: a child brick covers one
+// octant (4^3 voxels) of its parent's brick, each parent bit the OR of a 2^3 block of children.
+std::vector<Voxel> parents_of(const VoxelMask& set, const VoxelBox& parent_box) {
+  VoxelMask parents(parent_box);
+  const BrickIndex& ci = set.index();
+  Bits child;
+  for (size_t b = 0; b < ci.size(); ++b) {
+    if (!set.bits(b, child)) continue;
+    const Voxel origin = ci.brick_origin(b);  // multiples of 8, so halving is exact
+    const Voxel po{origin.x >> 1, origin.y >> 1, origin.z >> 1};
+    const int ox = po.x & 7, oy = po.y & 7, oz = po.z & 7;  // 0 or 4
+    Bits add{};
+    for (int k = 0; k < 4; ++k) {
+      uint64_t slice = child[size_t(2 * k)] | child[size_t(2 * k + 1)];
+      slice |= slice >> 8;  // row 2j |= row 2j + 1
+      slice |= slice >> 1;  // bit 2i |= bit 2i + 1
+      for (int j = 0; j < 4; ++j)
+        for (int i = 0; i < 4; ++i)
+          if ((slice >> (16 * j + 2 * i)) & 1) add[size_t(oz + k)] |= uint64_t(1) << ((oy + j) * 8 + ox + i);
+    }
+    parents.or_bits(parents.index().brick_of(po), add);
+  }
+  std::vector<Voxel> out = parents.to_vector();
+  std::sort(out.begin(), out.end());  // the order take_cached and the cache lookups have always seen
+  return out;
 }
 
 }  // namespace
@@ -369,7 +431,7 @@ Result<std::vector<LevelDependencies>> analyze_dependencies(const DependencyInpu
                    : step_back(*in.stencils, PyramidLevel{l}, step, dep, v, interrupter));
       dep.corrections += updates;
     }
-    if (l > 0) final_need = parents_of(dep.needed[0]);
+    if (l > 0) final_need = parents_of(dep.needed[0], boxes[size_t(l - 1)]);
   }
   return deps;
 }

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <set>
 #include <string>
 #include <vector>
 
@@ -58,6 +59,18 @@ void expect_identical(const std::vector<LevelDependencies>& a, const std::vector
   }
 }
 
+// Each coarser level's final version is asked for exactly the parents of the finer version 0.
+void expect_parents_match(const std::vector<LevelDependencies>& d) {
+  for (size_t l = 1; l < d.size(); ++l) {
+    std::set<Voxel> parents;
+    for (const Voxel& p : d[l].needed[0].to_vector()) parents.insert(parent_of(p));
+    std::vector<Voxel> finals = d[l - 1].needed.back().to_vector();
+    finals.insert(finals.end(), d[l - 1].cache_hits.begin(), d[l - 1].cache_hits.end());
+    EXPECT_EQ(std::set<Voxel>(finals.begin(), finals.end()), parents) << "level " << l;
+    EXPECT_EQ(int64_t(parents.size()), d[l - 1].needed_final) << "level " << l;
+  }
+}
+
 std::vector<TargetSet> targets() {
   std::vector<TargetSet> t;
   t.push_back(TargetSet::axis_cut('z', -3, -9, 5, 13, 11).value());  // straddles brick boundaries
@@ -78,7 +91,10 @@ TEST(Dependency, BrickPathMatchesPerVoxelPathForEverySchemeAndTarget) {
       for (const TargetSet& t : targets()) {
         SCOPED_TRACE(std::string(scheme_name(scheme)) + " " + field + " bounds " + std::to_string(t.bounds().lo.x) +
                      "," + std::to_string(t.bounds().lo.y) + "," + std::to_string(t.bounds().lo.z));
-        expect_identical(analyze(s, t, nullptr, true), analyze(s, t, nullptr, false));
+        const auto ref = analyze(s, t, nullptr, true);
+        const auto got = analyze(s, t, nullptr, false);
+        expect_identical(ref, got);
+        expect_parents_match(got);
       }
     }
   }
@@ -102,6 +118,7 @@ TEST(Dependency, BrickPathMatchesPerVoxelPathWithCachedVoxels) {
       const auto got = analyze(s, t, &cache, false);
       EXPECT_GT(ref.back().cache_hits.size(), 0u);
       expect_identical(ref, got);
+      expect_parents_match(got);
     }
   }
 }
