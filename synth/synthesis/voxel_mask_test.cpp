@@ -145,6 +145,37 @@ TEST(VoxelMask, ToVectorOrderDoesNotDependOnInsertionOrderOrThreads) {
   EXPECT_EQ(reversed.to_vector(), expected);
 }
 
+TEST(VoxelMask, WholeBrickAccessAgreesWithPerVoxelAccess) {
+  VoxelMask m(kBox);
+  const BrickIndex& index = m.index();
+  const Voxel p{-9, 3, -1};
+  const size_t b = index.brick_of(p);
+  VoxelMask::Bits bits;
+  EXPECT_FALSE(m.bits(b, bits));
+  m.or_bits(b, VoxelMask::Bits{});  // nothing to add: no brick allocated
+  EXPECT_EQ(m.bricks(), 0);
+  VoxelMask::Bits add{};
+  const int bit = BrickIndex::voxel_in_brick(p);
+  add[size_t(bit >> 6)] |= uint64_t(1) << (bit & 63);
+  add[7] |= uint64_t(1) << 63;  // the brick's highest voxel
+  m.or_bits(b, add);
+  m.or_bits(b, add);  // idempotent
+  EXPECT_EQ(m.bricks(), 1);
+  EXPECT_EQ(m.count(), 2);
+  EXPECT_TRUE(m.contains(p));
+  const Voxel top = BrickIndex::voxel_at(index.brick_origin(b), 511);
+  EXPECT_TRUE(m.contains(top));
+  EXPECT_FALSE(m.insert(top));
+  EXPECT_TRUE(m.insert({p.x + 1, p.y, p.z}));
+  ASSERT_TRUE(m.bits(b, bits));
+  EXPECT_EQ(bits[size_t(bit >> 6)] & add[size_t(bit >> 6)], add[size_t(bit >> 6)]);
+  EXPECT_EQ(m.count(), 3);
+  EXPECT_EQ(m.to_vector(), (std::vector<Voxel>{p, top, {p.x + 1, p.y, p.z}}));  // p.x + 1 starts the next brick
+  // The brick coordinates the cover starts at and spans.
+  EXPECT_EQ(index.first_brick(), (std::array<int, 3>{-3, -2, -2}));
+  EXPECT_EQ(index.extent(), (std::array<int, 3>{5, 4, 5}));
+}
+
 TEST(VoxelMask, MoveKeepsTheContents) {
   VoxelMask a(kBox);
   a.insert({-1, -1, -1});
