@@ -2,6 +2,7 @@
 //   [--queue N] [--deadline S] [--max-deadline S] [--cache-mb M] [--max-upload-mb M]
 //   [--max-image-side PX] [--max-image-pixels N] [--max-voxels N] [--max-field-nodes N]
 //   [--max-jobs N] [--analysis-threads N] [--max-mesh-vertices N] [--max-mesh-faces N] [--max-request-mb M]
+//   [--volume-state-mb M] [--idle-evict-s S]
 #include "args.h"
 #include "commands.h"
 #include "http_server.h"
@@ -12,7 +13,7 @@ Status run_serve(const std::vector<std::string>& argv) {
   Args args({"--host", "--port", "--data", "--threads", "--io-threads", "--queue", "--deadline", "--max-deadline",
              "--cache-mb", "--max-upload-mb", "--max-image-side", "--max-image-pixels", "--max-voxels",
              "--max-field-nodes", "--max-jobs", "--analysis-threads", "--max-mesh-vertices", "--max-mesh-faces",
-             "--max-request-mb"},
+             "--max-request-mb", "--volume-state-mb", "--idle-evict-s"},
             {});
   SOLIDTEX_RETURN_IF_ERROR(args.parse(argv));
   if (!args.positionals().empty())
@@ -38,6 +39,9 @@ Status run_serve(const std::vector<std::string>& argv) {
   c.max_voxels = int64_t(voxels);
   SOLIDTEX_ASSIGN_OR_RETURN(int request_mb, args.get_int("--max-request-mb", int(c.max_request_bytes >> 20), 16, 1 << 20));
   c.max_request_bytes = int64_t(request_mb) << 20;
+  SOLIDTEX_ASSIGN_OR_RETURN(int state_mb, args.get_int("--volume-state-mb", int(c.volume_state_bytes >> 20), 0, 1 << 20));
+  c.volume_state_bytes = int64_t(state_mb) << 20;
+  SOLIDTEX_ASSIGN_OR_RETURN(c.idle_evict_s, args.get_double("--idle-evict-s", c.idle_evict_s, 0, 1e6));
   SOLIDTEX_ASSIGN_OR_RETURN(double nodes, args.get_double("--max-field-nodes", double(c.max_field_nodes), 8, double(int64_t(1) << 24)));
   c.max_field_nodes = int64_t(nodes);
   SOLIDTEX_ASSIGN_OR_RETURN(double mesh_vertices, args.get_double("--max-mesh-vertices", double(c.mesh_limits.max_vertices), 3, 1e8));

@@ -32,6 +32,9 @@ constexpr const char* kUsage =
     "  field SKETCH.json -o FIELD.stf [--json]\n"
     "  serve [--host 127.0.0.1] [--port 8080] [--data DIR] [--threads N] [--queue N] [--deadline S]\n"
     "          [--cache-mb M] [--max-upload-mb M] [--max-image-side PX] [--max-voxels N] [--max-jobs N]\n"
+    "          [--max-request-mb 1536] [--volume-state-mb 512] [--idle-evict-s 300]\n"
+    "          --volume-state-mb bounds loaded volumes' tables, fields, bands and synthesizers (LRU\n"
+    "          eviction); --idle-evict-s evicts volumes idle that long (0: never); see README limits\n"
     "  exemplar KIND -o FILE.png [--size W,H] [--seed S]     KIND: wood, stripes, bricks, noise, spots\n";
 
 }  // namespace

@@ -179,8 +179,23 @@ S = {
      "feature_angle_degrees": number(1, 179, default=60),
      "curves": {"type": "array", "description": "features: user polylines on the surface (mesh coordinates); normals are taken from the nearest vertices.", "items": {"type": "array", "items": {"type": "array", "items": {"type": "number"}, "minItems": 3, "maxItems": 3}}}}},
  "Stats": {"type": "object", "properties": {"volume": {"type": "string"}, "levels": {"type": "array", "items": {"type": "object", "properties": {"level": {"type": "integer"}, "voxels_synthesized": {"type": "integer"}, "cached_voxels": {"type": "integer"}}}},
-     "cache": {"type": "object", "properties": {"bytes": {"type": "integer"}, "budget_bytes": {"type": "integer"}, "hits": {"type": "integer"}, "misses": {"type": "integer"}, "bricks": {"type": "integer"}, "evicted_bricks": {"type": "integer"}}},
+     "cache": {"type": "object", "description": "The volume's voxel cache: bytes is all it holds (bricks of 8^3 voxels), within its share of --cache-mb (budget_bytes).", "properties": {"bytes": {"type": "integer"}, "budget_bytes": {"type": "integer"}, "hits": {"type": "integer"}, "misses": {"type": "integer"}, "bricks": {"type": "integer"}, "evicted_bricks": {"type": "integer"}}},
+     "state": ref("VolumeState"),
      "requests": {"type": "integer"}, "recent": {"type": "array", "description": "The last requests (newest last): kind, target voxels and dependent-set sizes per level.", "items": {"type": "object"}}}},
+ "VolumeState": {"type": "object", "additionalProperties": False,
+     "description": "What the volume keeps loaded between requests outside its voxel cache, in resident bytes. Built at the first query (at creation for a surface label), evicted least recently used first when all loaded volumes together pass --volume-state-mb (default 512; never a state a running request uses, nor the most recently used one) or after --idle-evict-s (default 300) without requests, and rebuilt at the next query with the same bits. All byte counts are 0 while not loaded. /metrics gives the totals over the service (solidtex_volume_state_bytes, a table shared by several volumes counting once).",
+     "required": ["loaded", "bytes", "synthesizer_bytes", "table_bytes", "field_bytes", "surface_bytes", "active_requests", "loads", "evictions", "idle_seconds"],
+     "properties": {
+     "loaded": {"type": "boolean"},
+     "bytes": {"type": "integer", "minimum": 0, "description": "The sum of the four parts below."},
+     "synthesizer_bytes": {"type": "integer", "minimum": 0, "description": "Synthesizers' own state: per-level correction constants, stencils, schedules."},
+     "table_bytes": {"type": "integer", "minimum": 0, "description": "The candidate-triple tables in use (decoded: stacks, appearance vectors, candidates), shared with other loaded volumes of the same exemplars."},
+     "field_bytes": {"type": "integer", "minimum": 0, "description": "The frame field (a stored field's quaternion grid)."},
+     "surface_bytes": {"type": "integer", "minimum": 0, "description": "A surface label's distance band."},
+     "active_requests": {"type": "integer", "minimum": 0, "description": "Requests running on the state now."},
+     "loads": {"type": "integer", "minimum": 0, "description": "Times the state was built since the server started."},
+     "evictions": {"type": "integer", "minimum": 0, "description": "Times it was evicted since the server started."},
+     "idle_seconds": {"type": "number", "minimum": 0, "description": "Since its last request ended (or since it was created or the server started); 0 while a request runs."}}},
  **bundle("sketch.schema.json", {"": "Sketch", "vec3": "SketchVec3", "curve": "SketchCurve", "scalePoint": "SketchScalePoint", "frame": "SketchFrame"}),
  **bundle("volume.schema.json", {"": "VolumeSpec", "synthesisParams": "SynthesisParams", "placement": "Placement"}),
 }
@@ -189,7 +204,7 @@ MESH_EXAMPLE = "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 
 exemplar_links = {**links_to(EXEMPLAR_OPS, "/exemplar/id"), "get_job": link("get_job", "/job/id")}
 paths = {
  "/healthz": {"get": {"operationId": "healthz", "summary": "Liveness.", "responses": {"200": js({"type": "object", "required": ["status"], "properties": {"status": {"type": "string", "enum": ["ok", "stopping"]}, "queue_depth": {"type": "integer"}, "workers_busy": {"type": "integer"}}}), **errs("400")}}},
- "/metrics": {"get": {"operationId": "metrics", "summary": "Prometheus text: requests and latency histograms per route, voxels synthesized, cache bytes, queue depth.", "responses": {"200": {"description": "OK", "content": {"text/plain": {"schema": {"type": "string"}}}}}}},
+ "/metrics": {"get": {"operationId": "metrics", "summary": "Prometheus text: requests and latency histograms per route, voxels synthesized, cache bytes and budget, queue depth, loaded volumes' state bytes and budget (solidtex_volume_state_bytes, solidtex_volume_state_budget_bytes, solidtex_volumes_loaded) and evictions by reason.", "responses": {"200": {"description": "OK", "content": {"text/plain": {"schema": {"type": "string"}}}}}}},
  "/v1/openapi.json": {"get": {"operationId": "openapi", "summary": "This document.", "responses": {"200": js({"type": "object"})}}},
  "/v1/exemplars": {
    "get": {"operationId": "list_exemplars", "summary": "List exemplars.", "responses": {"200": {**js({"type": "object", "properties": {"exemplars": {"type": "array", "items": ref("Exemplar")}}}),
@@ -282,7 +297,7 @@ paths = {
      "requestBody": {"required": True, "content": {"application/json": {"schema": ref("FieldFromMesh")}}},
      "responses": {"201": created(ref("Field"), links_to(FIELD_OPS)), **errs("400", "404", "413", "415", "422", "503", "504")}}},
  "/v1/volumes/{id}/stats": {"parameters": [pid()],
-   "get": {"operationId": "volume_stats", "summary": "Voxels per level, cache bytes and hits, the last requests' dependent-set sizes.", "responses": {"200": js(ref("Stats")), **errs("404")}}},
+   "get": {"operationId": "volume_stats", "summary": "Voxels per level, cache bytes and hits, the loaded state's resident bytes and evictions, the last requests' dependent-set sizes.", "responses": {"200": js(ref("Stats")), **errs("404")}}},
 }
 doc = {"openapi": "3.1.0", "info": {"title": "solidtex", "version": "1.0.0", "description": "Lazy solid-texture volumes (Zhang et al. 2011). Errors always have the shape {\"error\": {\"code\", \"message\", \"field\"}}. Ids are opaque strings. Synthesis requests run on a bounded worker pool: when its queue is full the answer is 503 with Retry-After. World units are finest-level voxels. Query parameters are strict: an unknown or repeated one is refused (400). Lists in the query are comma-separated (`size=64,64`). The limits that depend on flags of `solidtex serve` are given with their defaults; over them the answer is 422 (413 only for a body over --max-upload-mb)."},
        "paths": paths, "components": {"schemas": S}}

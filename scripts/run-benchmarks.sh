@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Runs every benchmark in bench/ and prints one JSON document:
 #   {"analysis": [...], "slice": {...}, "field": {...}, "surface": {...}, "service": {...},
-#    "quality": {...}}. Takes about two hours on 2 cores (QUALITY_SIZE=128 for a quicker quality run).
+#    "quality": {...}, "rss": {...}}. Takes about two hours on 2 cores (QUALITY_SIZE=128 for a quicker
+#    quality run; RSS_QUICK=1 for smaller memory probes).
 # Uses ../shared/data/exemplars/wood_grain.png when present, else a procedural wood exemplar.
 set -euo pipefail
 build=${1:-build}
@@ -38,4 +39,7 @@ echo ', "service":'
 "$build/venv/bin/python" "$(dirname "$0")/../bench/bench_service.py" "$build"
 echo ', "quality":'
 "$build/venv/bin/python" "$(dirname "$0")/../bench/bench_quality.py" "$build" --size "${QUALITY_SIZE:-256}"
+echo ', "rss":'
+"$build/venv/bin/python" "$(dirname "$0")/../bench/bench_rss.py" "$build" --cache-mb "${RSS_CACHE_MB:-256}" \
+  ${RSS_QUICK:+--quick} 2>/dev/null
 echo '}'

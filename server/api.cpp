@@ -214,7 +214,15 @@ HttpResponse Api::metrics(const HttpRequest&) {
   g.workers_busy = pool_.running();
   g.queue_capacity = pool_.capacity();
   g.cache_bytes = volumes_.cache_bytes();
+  g.cache_budget_bytes = config_.cache_bytes;
   g.voxels_synthesized = volumes_.voxels_synthesized();
+  const VolumeStateTotals state = volumes_.state_totals();
+  g.volume_state_bytes = state.bytes;
+  g.volume_state_budget_bytes = state.budget_bytes;
+  g.volumes_loaded = state.loaded;
+  g.volume_state_loads = state.loads;
+  g.volume_evictions_budget = state.evicted_budget;
+  g.volume_evictions_idle = state.evicted_idle;
   g.analysis_jobs = exemplars_.jobs_pending();
   HttpResponse out;
   out.content_type = "text/plain; version=0.0.4";

@@ -40,7 +40,7 @@ struct Entry {
   json levels;
   int64_t table_bytes = 0;
   double seconds = 0;
-  std::shared_ptr<const Table> table;
+  std::weak_ptr<const Table> table;  // decoded, while a loaded volume holds it
   bool cancel = false;  // DELETE while running: the analysis stops, then the exemplar goes
 };
 
@@ -64,13 +64,46 @@ struct ExemplarService::Impl {
 
   Impl(DataStore& s, const ServerConfig& c) : store(s), config(c) {}
 
+  // `max_bytes` > 0: the analysis cost limit, checked as the images are decoded (uploads).
   Result<ExemplarSet> build_set(const std::vector<std::pair<std::string, std::vector<uint8_t>>>& parts,
-                                const std::string& grain, float mask_weight, AnalysisParams& params) const {
+                                const std::string& grain, float mask_weight, AnalysisParams& params,
+                                int64_t max_bytes = 0) const {
     ExemplarInputs in;
-    bool have_xy = false;
+    bool have_xy = false, have_mask = false;
     for (const auto& [name, bytes] : parts) {
+      if (name != "xy" && name != "yz" && name != "zx" && name != "mask" && name != "mask_yz" && name != "mask_zx")
+        return Status(StatusCode::kInvalidArgument, "unknown part (expected xy, yz, zx, mask, mask_yz, mask_zx)", name);
+      have_mask = have_mask || name.rfind("mask", 0) == 0;
+    }
+    // The analysis cost model is linear in the planes' pixels: check it after each exemplar image
+    // (exemplars first, masks after), so that a small body of several huge images (blank PNGs
+    // compress to almost nothing) is refused after decoding one of them, never all six.
+    int64_t per_pixel = 0;
+    {
+      ExemplarInputs tiny;
+      tiny.xy = ImageF(8, 8, 3);
+      if (have_mask) tiny.mask_xy = ImageF(8, 8, 3);
+      if (auto t = ExemplarSet::create(std::move(tiny))) per_pixel = estimate_analysis_bytes(*t, params) / 64;
+    }
+    int64_t pixels = 0;
+    std::vector<const std::pair<std::string, std::vector<uint8_t>>*> ordered;
+    for (const auto& part : parts)
+      if (part.first.rfind("mask", 0) != 0) ordered.push_back(&part);
+    for (const auto& part : parts)
+      if (part.first.rfind("mask", 0) == 0) ordered.push_back(&part);
+    for (const auto* part : ordered) {
+      const auto& [name, bytes] = *part;
       auto img = decode_image(bytes, config.image_limits, name);
       if (!img) return as_upload_error(img.status());
+      if (name.rfind("mask", 0) != 0) {
+        pixels += img->pixel_count() * (name == "xy" && grain == "x" ? 3 : 1);  // grain x: xy in all planes
+        if (const int64_t at_least = pixels * per_pixel; max_bytes > 0 && at_least > max_bytes)
+          return Status(StatusCode::kUnprocessable,
+                        "analysing this exemplar needs at least " + std::to_string(at_least >> 20) + " MB; the limit is " +
+                            std::to_string(max_bytes >> 20) +
+                            " MB (--max-request-mb): send a smaller image or fewer levels",
+                        name);
+      }
       if (name == "xy") { in.xy = std::move(*img); have_xy = true; }
       else if (name == "yz") in.yz = std::move(*img);
       else if (name == "zx") in.zx = std::move(*img);
@@ -311,7 +344,8 @@ Result<json> ExemplarService::upload(ExemplarUpload up) {
   AnalysisParams params = up.params;
   params.search_k = std::max(params.search_k, params.candidates / 2 + 1);
   SOLIDTEX_RETURN_IF_ERROR(params.validate());
-  SOLIDTEX_ASSIGN_OR_RETURN(ExemplarSet set, impl_->build_set(up.parts, up.grain, up.mask_weight, params));
+  SOLIDTEX_ASSIGN_OR_RETURN(ExemplarSet set,
+                            impl_->build_set(up.parts, up.grain, up.mask_weight, params, impl_->config.max_request_bytes));
   if (const int64_t bytes = estimate_analysis_bytes(set, params); bytes > impl_->config.max_request_bytes)
     return Status(StatusCode::kUnprocessable,
                   "analysing this exemplar needs about " + std::to_string(bytes >> 20) + " MB; the limit is " +
@@ -396,22 +430,32 @@ Status ExemplarService::remove(const std::string& id, const std::function<bool(c
   return Status::ok();
 }
 
+Status ExemplarService::check_ready(const std::string& id) const {
+  std::lock_guard<std::mutex> g(impl_->mutex);
+  auto it = impl_->entries.find(id);
+  if (it == impl_->entries.end()) return Status(StatusCode::kNotFound, "no exemplar '" + id + "'", "exemplar");
+  if (it->second.state != State::kReady)
+    return Status(StatusCode::kFailedPrecondition, "exemplar '" + id + "' is not ready", "exemplar");
+  return Status::ok();
+}
+
 Result<std::shared_ptr<const Table>> ExemplarService::table(const std::string& id) {
   {
+    SOLIDTEX_RETURN_IF_ERROR(check_ready(id));
     std::lock_guard<std::mutex> g(impl_->mutex);
     auto it = impl_->entries.find(id);
-    if (it == impl_->entries.end()) return Status(StatusCode::kNotFound, "no exemplar '" + id + "'", "exemplar");
-    if (it->second.state != State::kReady)
-      return Status(StatusCode::kFailedPrecondition, "exemplar '" + id + "' is not ready", "exemplar");
-    if (it->second.table) return it->second.table;
+    if (it != impl_->entries.end())
+      if (auto held = it->second.table.lock()) return held;
   }
   // Decoding (Table::assemble rebuilds stacks) runs outside the lock.
   SOLIDTEX_ASSIGN_OR_RETURN(auto bytes, table_bytes(id));
   SOLIDTEX_ASSIGN_OR_RETURN(auto table, decode_table(bytes));
   std::lock_guard<std::mutex> g(impl_->mutex);
   auto it = impl_->entries.find(id);
-  if (it != impl_->entries.end() && !it->second.table) it->second.table = table;
-  return it != impl_->entries.end() ? it->second.table : table;
+  if (it == impl_->entries.end()) return table;
+  if (auto held = it->second.table.lock()) return held;  // decoded meanwhile by another request
+  it->second.table = table;
+  return table;
 }
 
 Result<std::vector<uint8_t>> ExemplarService::table_bytes(const std::string& id) const {

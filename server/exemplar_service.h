@@ -50,8 +50,12 @@ class ExemplarService {
   Result<nlohmann::json> job(const std::string& job_id) const;
   // kFailedPrecondition while analysing or when `in_use(id)` says a volume needs it.
   Status remove(const std::string& id, const std::function<bool(const std::string&)>& in_use);
-  // The decoded table of a ready exemplar (kFailedPrecondition otherwise); cached in memory.
+  // The decoded table of a ready exemplar (kFailedPrecondition otherwise). Shared while anyone
+  // holds it (the loaded volumes that use it): the service keeps only a weak reference, so a
+  // table no loaded volume uses is freed and decoded again (the same bits) when next asked for.
   Result<std::shared_ptr<const Table>> table(const std::string& id);
+  // What table() would refuse with, without decoding anything (kNotFound, kFailedPrecondition).
+  Status check_ready(const std::string& id) const;
   Result<std::vector<uint8_t>> table_bytes(const std::string& id) const;
   int jobs_pending() const;
 

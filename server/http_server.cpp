@@ -4,6 +4,9 @@
 #include <restinio/helpers/http_field_parsers/content-disposition.hpp>
 #include <restinio/helpers/multipart_body.hpp>
 
+#include <malloc.h>
+
+#include <algorithm>
 #include <csignal>
 #include <iostream>
 #include <mutex>
@@ -103,7 +106,11 @@ class Server {
     fields_ = std::make_unique<FieldService>(*store_, config_);
     meshes_ = std::make_unique<MeshService>(*store_, config_);
     volumes_ = std::make_unique<VolumeService>(*store_, config_, *exemplars_, *fields_, *meshes_);
-    pool_ = std::make_unique<WorkerPool>(config_.threads, config_.queue);
+    // Memory a request freed goes back to the system once no request runs (README, "Memory"):
+    // otherwise glibc keeps it in the arena of whichever thread freed it, where another
+    // thread's next request cannot reuse it, and the process grows by a request's working memory
+    // per arena.
+    pool_ = std::make_unique<WorkerPool>(config_.threads, config_.queue, [] { malloc_trim(0); });
     api_ = std::make_unique<Api>(config_, *exemplars_, *fields_, *volumes_, *meshes_, metrics_, *pool_, abort_running_);
     SOLIDTEX_RETURN_IF_ERROR(fields_->start(&report));
     SOLIDTEX_RETURN_IF_ERROR(exemplars_->start(&report));
@@ -310,6 +317,10 @@ class Server {
 
 Status run_server(const ServerConfig& config) {
   SOLIDTEX_RETURN_IF_ERROR(config.validate());
+  // Few malloc arenas (glibc makes up to 8 per core, one per thread that allocates at once):
+  // freed memory stays in its arena, so each extra arena can hold another request's working
+  // memory. One per synthesis worker measured the lowest peaks at no cost in speed (bench_rss).
+  mallopt(M_ARENA_MAX, std::max(2, config.threads));
   Server server(config);
   return server.run();
 }

@@ -1,6 +1,6 @@
 // Prometheus text-format metrics: request counts by route, method and status; latency
 // histograms by route; plus gauges the caller samples at scrape time (queue depth, cache
-// bytes, voxels synthesized, analysis jobs). Thread-safe.
+// bytes, voxels synthesized, analysis jobs, loaded volumes' state and evictions). Thread-safe.
 #pragma once
 
 #include <cstdint>
@@ -17,8 +17,16 @@ struct MetricGauges {
   int workers_busy = 0;
   int queue_capacity = 0;
   int64_t cache_bytes = 0;
+  int64_t cache_budget_bytes = 0;  // --cache-mb
   int64_t voxels_synthesized = 0;  // counter: over all volumes since start
   int analysis_jobs = 0;           // queued or running
+  // Loaded volumes' state outside the voxel cache (VolumeStateTotals).
+  int64_t volume_state_bytes = 0;
+  int64_t volume_state_budget_bytes = 0;
+  int64_t volumes_loaded = 0;
+  int64_t volume_state_loads = 0;       // counter
+  int64_t volume_evictions_budget = 0;  // counter
+  int64_t volume_evictions_idle = 0;    // counter
 };
 
 class Metrics {

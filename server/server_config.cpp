@@ -26,6 +26,8 @@ Status ServerConfig::validate() const {
   if (max_voxels < 1 || max_voxels > kMaxTargetSamples) return out_of_range("--max-voxels", "[1, 2^24]");
   if (max_request_bytes < (int64_t(16) << 20) || max_request_bytes > (int64_t(1) << 40))
     return out_of_range("--max-request-mb", "[16, 1048576]");
+  if (volume_state_bytes < 0 || volume_state_bytes > (int64_t(1) << 40)) return out_of_range("--volume-state-mb", "[0, 1048576]");
+  if (!(idle_evict_s >= 0 && idle_evict_s <= 1e6)) return out_of_range("--idle-evict-s", "[0, 1e6]");
   if (max_field_nodes < 8 || max_field_nodes > (int64_t(1) << 24)) return out_of_range("--max-field-nodes", "[8, 2^24]");
   if (max_jobs < 1 || max_jobs > 1000) return out_of_range("--max-jobs", "[1, 1000]");
   if (analysis_threads < 1 || analysis_threads > 16) return out_of_range("--analysis-threads", "[1, 16]");

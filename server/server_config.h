@@ -27,6 +27,12 @@ struct ServerConfig {
   // Working memory of one synthesis request (dependency sets and level stores), bytes,
   // [16 MiB, 1 TiB]; estimated before any work and checked again after dependency analysis: 422.
   int64_t max_request_bytes = int64_t(1536) << 20;
+  // Loaded volumes' state outside the voxel cache (tables, fields, surface bands, synthesizers),
+  // bytes, [0, 1 TiB]: beyond it least-recently-used idle volumes are evicted (0: every volume is
+  // evicted when its last request ends). One volume larger than this alone is still served.
+  int64_t volume_state_bytes = int64_t(512) << 20;
+  // A loaded volume no request used for this long is evicted, seconds, [0, 1e6]; 0: never.
+  double idle_evict_s = 300;
   int64_t max_field_nodes = int64_t(1) << 18;     // frame-field grid nodes per field: 422 beyond
   MeshLimits mesh_limits;           // vertex and face counts per mesh: 422 beyond
   int max_jobs = 4;                 // analysis jobs queued or running, [1, 1000]; beyond: 429

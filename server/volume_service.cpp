@@ -1,17 +1,21 @@
 #include "volume_service.h"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <deque>
 #include <map>
 #include <mutex>
 #include <string_view>
+#include <thread>
 
 #include "api_json.h"
 #include "field/field_file.h"
 #include "core/json_fields.h"
 #include "query_params.h"
 #include "synthesis/region_volume.h"
+#include "synthesis/resident_bytes.h"
 #include "synthesis/synthesizer.h"
 
 namespace solidtex::server {
@@ -41,18 +45,45 @@ bool field_spec_matches(std::string_view s) {
   return false;
 }
 
+using Clock = std::chrono::steady_clock;
+
+// What a loaded volume keeps between requests, outside its voxel cache: built at its first query
+// (at creation for a surface label, whose band creation builds anyway), shared by the requests
+// running on it, and dropped when the volume is evicted (LRU over --volume-state-mb, or idle
+// for --idle-evict-s); rebuilt the same, bit for bit, at its next query. Immutable once built.
+struct VolumeState {
+  std::vector<std::shared_ptr<Synthesizer>> synths;  // one per exemplar (region)
+  std::shared_ptr<RegionVolume> regions;
+  std::shared_ptr<const FrameField> field;
+  std::shared_ptr<const SurfaceDistance> surface;
+  std::vector<std::shared_ptr<const Table>> tables;  // distinct; shared with other volumes of the exemplar
+  std::vector<int64_t> table_bytes;                  // per entry of `tables`
+  int64_t synthesizer_bytes = 0, field_bytes = 0, surface_bytes = 0;
+
+  int64_t own_bytes() const { return synthesizer_bytes + field_bytes + surface_bytes; }
+  int64_t tables_bytes() const {
+    int64_t b = 0;
+    for (int64_t t : table_bytes) b += t;
+    return b;
+  }
+  int64_t bytes() const { return own_bytes() + tables_bytes(); }
+};
+
 struct Volume {
   json info;                                  // volume.json (the spec as given, plus id)
   std::vector<std::string> exemplar_ids;      // one, or two with a region label
-  std::optional<RegionLabel> label;
-  std::shared_ptr<const FrameField> field;
+  std::optional<RegionLabel> label;           // a surface label's band lives in the state
+  std::shared_ptr<const FrameField> inline_field;  // identity or an inline spec; null: field.stf
+  json surface_mesh;                          // regions.mesh of a surface label, else null
   json params_spec = json::object();          // as given; plane weights default per table
   uint32_t seed = 1;
-  // Built at the first query.
-  std::mutex build_mutex;
-  json pending_surface;  // a loaded volume's surface label: its distance band is built at first use
-  std::vector<std::shared_ptr<Synthesizer>> synths;
-  std::shared_ptr<RegionVolume> regions;
+  std::mutex build_mutex;                     // one build at a time
+  // Guarded by the service mutex.
+  std::shared_ptr<VolumeState> state;         // null while not loaded
+  int active = 0;                             // requests running on the state
+  Clock::time_point last_used = Clock::now(); // end of the last request (or load, creation)
+  uint64_t last_tick = 0;                     // LRU order
+  int64_t loads = 0, evictions = 0;
   // Statistics.
   std::mutex stats_mutex;
   std::vector<int64_t> voxels_per_level;
@@ -98,19 +129,33 @@ struct VolumeService::Impl {
   std::map<std::string, std::shared_ptr<Volume>> volumes;
   std::atomic<int64_t> voxels_total{0};
   std::vector<std::weak_ptr<Synthesizer>> live;  // every synthesizer built (guarded by mutex)
+  // Loaded state (guarded by mutex).
+  uint64_t tick = 0;
+  int64_t loads_total = 0, evicted_budget = 0, evicted_idle = 0;
+  // The idle sweeper.
+  std::condition_variable sweep_wake;
+  bool stopping = false;
+  std::thread sweeper;
 
   Impl(DataStore& s, const ServerConfig& c, ExemplarService& e, FieldService& f, MeshService& m)
       : store(s), config(c), exemplars(e), fields(f), meshes(m) {}
+  ~Impl() {
+    {
+      std::lock_guard<std::mutex> g(mutex);
+      stopping = true;
+    }
+    sweep_wake.notify_all();
+    if (sweeper.joinable()) sweeper.join();
+  }
 
-  // The surface-distance label's mesh: from the mesh service when creating (bytes copied into
-  // `mesh_bytes`), from the volume's own copy when loading.
-  Status attach_surface(Volume& v, const json& mesh_spec, const std::vector<uint8_t>& bytes) {
+  // The band of a surface label: the mesh (the volume's copy, or the mesh service's bytes when
+  // creating) placed as `mesh_spec` says.
+  Result<std::shared_ptr<const SurfaceDistance>> build_surface(const Volume& v, const json& mesh_spec,
+                                                               const std::vector<uint8_t>& bytes) {
     SOLIDTEX_ASSIGN_OR_RETURN(Mesh mesh, meshes.decode(bytes));
     SOLIDTEX_ASSIGN_OR_RETURN(Placement placement,
                               placement_from_json(mesh_spec.value("placement", json::object()), "regions.mesh.placement", mesh.bounds(), nullptr));
-    SOLIDTEX_ASSIGN_OR_RETURN(v.label->surface, SurfaceDistance::create(mesh, placement, v.label->distance + 1,
-                                                                        config.max_request_bytes));
-    return Status::ok();
+    return SurfaceDistance::create(mesh, placement, v.label->distance + 1, config.max_request_bytes);
   }
 
   // Parses a spec (strictly) into a Volume; `field_bytes` receives the stored field to copy.
@@ -148,6 +193,7 @@ struct VolumeService::Impl {
         SOLIDTEX_RETURN_IF_ERROR(check_keys(r["mesh"], {"id", "placement"}, "regions.mesh"));
         if (!r["mesh"].contains("id")) return Status(StatusCode::kInvalidArgument, "is required", "regions.mesh.id");
         SOLIDTEX_RETURN_IF_ERROR(json_text(r["mesh"]["id"], "regions.mesh.id", 64).status());
+        v->surface_mesh = r["mesh"];
       }
     }
     if (j.contains("seed")) {
@@ -190,49 +236,190 @@ struct VolumeService::Impl {
     if (!stored_field) {  // inline spec, or identity by default
       auto parsed = parse_field_spec(spec);
       if (!parsed) return Status(StatusCode::kInvalidArgument, parsed.status().message(), "field.spec");
-      v->field = *parsed;
+      v->inline_field = *parsed;
     }
     return v;
   }
 
   Status check_exemplars_ready(const Volume& v) {
-    for (size_t i = 0; i < v.exemplar_ids.size(); ++i) {
-      auto t = exemplars.table(v.exemplar_ids[i]);
-      if (!t) return Status(t.status().code(), t.status().message(), v.label ? "regions.exemplars" : "exemplar");
+    for (const std::string& id : v.exemplar_ids) {
+      Status st = exemplars.check_ready(id);
+      if (!st.is_ok()) return Status(st.code(), st.message(), v.label ? "regions.exemplars" : "exemplar");
     }
     return Status::ok();
   }
 
-  // Builds the synthesizers at the first query.
-  Status build(Volume& v) {
-    std::lock_guard<std::mutex> g(v.build_mutex);
-    if (!v.synths.empty()) return Status::ok();
-    if (!v.pending_surface.is_null()) {  // start-up never builds unbounded work before listening
-      SOLIDTEX_ASSIGN_OR_RETURN(auto bytes,
-                                store.read(ResourceKind::kVolume, v.info["id"].get<std::string>(), "mesh.source"));
-      SOLIDTEX_RETURN_IF_ERROR(attach_surface(v, v.pending_surface, bytes));
-      v.pending_surface = nullptr;
+  // Builds a volume's state: field (the volume's own copy of a stored one), surface band,
+  // tables, synthesizers. `surface` and `field`, when given, were just built by create().
+  Result<std::shared_ptr<VolumeState>> build_state(const Volume& v, std::shared_ptr<const SurfaceDistance> surface,
+                                                   std::shared_ptr<const FrameField> field) {
+    const std::string id = v.info["id"].get<std::string>();
+    auto st = std::make_shared<VolumeState>();
+    if (field) st->field = std::move(field);
+    else if (v.inline_field) st->field = v.inline_field;
+    else {
+      SOLIDTEX_ASSIGN_OR_RETURN(auto stored, load_field(store.path(ResourceKind::kVolume, id, "field.stf")));
+      st->field = stored;
     }
-    std::vector<std::shared_ptr<Synthesizer>> synths;
+    if (v.label && v.label->kind == RegionLabel::Kind::kSurfaceShell) {
+      if (surface) {
+        st->surface = std::move(surface);
+      } else {  // start-up never builds bands before listening: the first query does
+        SOLIDTEX_ASSIGN_OR_RETURN(auto bytes, store.read(ResourceKind::kVolume, id, "mesh.source"));
+        SOLIDTEX_ASSIGN_OR_RETURN(st->surface, build_surface(v, v.surface_mesh, bytes));
+      }
+    }
     for (const std::string& eid : v.exemplar_ids) {
       SOLIDTEX_ASSIGN_OR_RETURN(auto table, exemplars.table(eid));
       SynthesisParams base;
       base.plane_weights = table->params().suggested_plane_weights;
       SOLIDTEX_ASSIGN_OR_RETURN(SynthesisParams params, synthesis_params_from_json(v.params_spec, "params", base));
       params.seed = v.seed;
-      SOLIDTEX_ASSIGN_OR_RETURN(auto s, Synthesizer::create(table, v.field, params, 0));
-      synths.push_back(s);
+      SOLIDTEX_ASSIGN_OR_RETURN(auto s, Synthesizer::create(table, st->field, params, 0));
+      st->synths.push_back(s);
+      st->synthesizer_bytes += synthesizer_state_bytes(*s);
+      if (std::find(st->tables.begin(), st->tables.end(), table) == st->tables.end()) {
+        st->tables.push_back(table);
+        st->table_bytes.push_back(table_resident_bytes(*table));
+      }
     }
     if (v.label) {
-      SOLIDTEX_ASSIGN_OR_RETURN(v.regions, RegionVolume::create(synths, *v.label));
+      RegionLabel label = *v.label;
+      label.surface = st->surface;
+      SOLIDTEX_ASSIGN_OR_RETURN(st->regions, RegionVolume::create(st->synths, label));
+      st->synthesizer_bytes += int64_t(sizeof(RegionVolume));
     }
-    v.synths = synths;
+    st->field_bytes = field_resident_bytes(*st->field);
+    st->surface_bytes = st->surface ? st->surface->resident_bytes() : 0;
+    return st;
+  }
+
+  // --- loaded state: acquire, release, eviction (the service mutex guards all of it) ---------
+
+  void touch(Volume& v) {
+    v.last_used = Clock::now();
+    v.last_tick = ++tick;
+  }
+
+  bool registered_locked(const std::shared_ptr<Volume>& v) const {
+    auto it = volumes.find(v->info["id"].get<std::string>());
+    return it != volumes.end() && it->second == v;
+  }
+
+  // Resident bytes of every loaded volume's state; a table several volumes use counts once.
+  int64_t state_bytes_locked() const {
+    int64_t bytes = 0;
+    std::map<const Table*, int64_t> tables;
+    for (const auto& [id, v] : volumes)
+      if (v->state) {
+        bytes += v->state->own_bytes();
+        for (size_t i = 0; i < v->state->tables.size(); ++i) tables[v->state->tables[i].get()] = v->state->table_bytes[i];
+      }
+    for (const auto& [t, b] : tables) bytes += b;
+    return bytes;
+  }
+
+  void evict_locked(Volume& v, std::vector<std::shared_ptr<VolumeState>>& dropped) {
+    dropped.push_back(std::move(v.state));
+    v.state.reset();
+    ++v.evictions;
+  }
+
+  // Evicts least-recently-used idle states while the total is over --volume-state-mb. Never a
+  // state that running requests use (the total may exceed the budget while they run), nor the
+  // most recently used one: a volume larger than the budget alone stays loaded while it is the
+  // one in use, rather than being rebuilt at every query (until it idles or another is used).
+  void evict_over_budget_locked(std::vector<std::shared_ptr<VolumeState>>& dropped) {
+    int64_t total = state_bytes_locked();
+    while (total > config.volume_state_bytes) {
+      Volume* victim = nullptr;
+      Volume* newest = nullptr;
+      for (auto& [id, v] : volumes)
+        if (v->state && (!newest || v->last_tick > newest->last_tick)) newest = v.get();
+      for (auto& [id, v] : volumes)
+        if (v->state && v->active == 0 && v.get() != newest && (!victim || v->last_tick < victim->last_tick))
+          victim = v.get();
+      if (!victim) break;
+      evict_locked(*victim, dropped);
+      ++evicted_budget;
+      total = state_bytes_locked();
+    }
+  }
+
+  void evict_idle_locked(std::vector<std::shared_ptr<VolumeState>>& dropped) {
+    const auto now = Clock::now();
+    const auto idle = std::chrono::duration<double>(config.idle_evict_s);
+    for (auto& [id, v] : volumes)
+      if (v->state && v->active == 0 && now - v->last_used >= idle) {
+        evict_locked(*v, dropped);
+        ++evicted_idle;
+      }
+  }
+
+  void sweep_loop() {
+    const double period = std::clamp(config.idle_evict_s / 4, 0.05, 5.0);
+    std::unique_lock<std::mutex> lock(mutex);
+    while (!stopping) {
+      sweep_wake.wait_for(lock, std::chrono::duration<double>(period));
+      if (stopping) break;
+      std::vector<std::shared_ptr<VolumeState>> dropped;
+      evict_idle_locked(dropped);
+      if (dropped.empty()) continue;
+      lock.unlock();
+      dropped.clear();  // frees outside the lock
+      rebalance_cache();
+      lock.lock();
+    }
+  }
+
+  // Installs a freshly built state as the volume's (unless it was deleted meanwhile: then only
+  // the request that built it uses it), makes room under the budget and rebalances the cache.
+  void install(const std::shared_ptr<Volume>& v, const std::shared_ptr<VolumeState>& st, bool for_request) {
+    std::vector<std::shared_ptr<VolumeState>> dropped;
     {
-      std::lock_guard<std::mutex> g2(mutex);
-      for (auto& s : synths) live.push_back(s);
+      std::lock_guard<std::mutex> g(mutex);
+      if (for_request) ++v->active;
+      touch(*v);
+      if (registered_locked(v)) {
+        v->state = st;
+        ++v->loads;
+        ++loads_total;
+        for (auto& s : st->synths) live.push_back(s);
+        evict_over_budget_locked(dropped);
+      }
     }
+    dropped.clear();
     rebalance_cache();
-    return Status::ok();
+  }
+
+  // The volume's state for one request, built when not loaded; release() must follow.
+  Result<std::shared_ptr<VolumeState>> acquire(const std::shared_ptr<Volume>& v) {
+    auto loaded = [&]() -> std::shared_ptr<VolumeState> {
+      std::lock_guard<std::mutex> g(mutex);
+      if (!v->state) return nullptr;
+      ++v->active;
+      touch(*v);
+      return v->state;
+    };
+    if (auto st = loaded()) return st;
+    std::lock_guard<std::mutex> b(v->build_mutex);
+    if (auto st = loaded()) return st;  // built by another request meanwhile
+    SOLIDTEX_ASSIGN_OR_RETURN(auto st, build_state(*v, nullptr, nullptr));
+    install(v, st, true);
+    return st;
+  }
+
+  void release(Volume& v) {
+    std::vector<std::shared_ptr<VolumeState>> dropped;
+    {
+      std::lock_guard<std::mutex> g(mutex);
+      --v.active;
+      touch(v);
+      evict_over_budget_locked(dropped);  // what running requests held may now go
+    }
+    if (dropped.empty()) return;
+    dropped.clear();
+    rebalance_cache();
   }
 
   // Splits the cache budget evenly over every live synthesizer.
@@ -241,7 +428,7 @@ struct VolumeService::Impl {
     for (auto& s : synths) s->cache().set_budget_bytes(config.cache_bytes / int64_t(std::max<size_t>(1, synths.size())));
   }
 
-  // Drops the synthesizers of deleted volumes (once their last query ended) from the list.
+  // Drops the synthesizers of evicted and deleted volumes (once their last query ended).
   std::vector<std::shared_ptr<Synthesizer>> live_synthesizers() {
     std::lock_guard<std::mutex> g(mutex);
     std::vector<std::shared_ptr<Synthesizer>> out;
@@ -276,15 +463,13 @@ Status VolumeService::start(std::vector<std::string>* report) {
       json spec = info["spec"];
       json desc;
       SOLIDTEX_ASSIGN_OR_RETURN(auto v, impl_->parse_spec(spec, nullptr, &desc));
-      if (info["field"].value("kind", "") == "stored") {
-        SOLIDTEX_ASSIGN_OR_RETURN(auto field, load_field(impl_->store.path(ResourceKind::kVolume, id, "field.stf")));
-        v->field = field;
+      if (info["field"].value("kind", "") == "stored") {  // checked now, loaded at the first query
+        SOLIDTEX_RETURN_IF_ERROR(load_field(impl_->store.path(ResourceKind::kVolume, id, "field.stf")).status());
+        v->inline_field = nullptr;
       }
-      if (v->label && v->label->kind == RegionLabel::Kind::kSurfaceShell) {
-        if (!impl_->store.exists(ResourceKind::kVolume, id, "mesh.source"))
-          return Status(StatusCode::kCorrupt, "the volume's mesh copy is missing", "mesh.source");
-        v->pending_surface = spec["regions"]["mesh"];
-      }
+      if (v->label && v->label->kind == RegionLabel::Kind::kSurfaceShell &&
+          !impl_->store.exists(ResourceKind::kVolume, id, "mesh.source"))
+        return Status(StatusCode::kCorrupt, "the volume's mesh copy is missing", "mesh.source");
       v->info = info;
       return v;
     };
@@ -295,6 +480,8 @@ Status VolumeService::start(std::vector<std::string>* report) {
     }
     impl_->volumes.emplace(id, *v);
   }
+  if (impl_->config.idle_evict_s > 0 && !impl_->sweeper.joinable())
+    impl_->sweeper = std::thread([this] { impl_->sweep_loop(); });
   return Status::ok();
 }
 
@@ -304,19 +491,20 @@ Result<json> VolumeService::create(const std::string& spec_text) {
   std::vector<uint8_t> field_bytes;
   json field_desc;
   SOLIDTEX_ASSIGN_OR_RETURN(auto v, impl_->parse_spec(spec, &field_bytes, &field_desc));
+  std::shared_ptr<const FrameField> field = v->inline_field;
   if (!field_bytes.empty()) {
     SOLIDTEX_ASSIGN_OR_RETURN(auto stored, decode_field(field_bytes));
-    SOLIDTEX_ASSIGN_OR_RETURN(auto field, QuatGridField::create(stored.origin, stored.spacing, stored.dims, stored.nodes, stored.log_scales));
-    v->field = field;
+    SOLIDTEX_ASSIGN_OR_RETURN(field, QuatGridField::create(stored.origin, stored.spacing, stored.dims, stored.nodes, stored.log_scales));
   }
   SOLIDTEX_RETURN_IF_ERROR(impl_->check_exemplars_ready(*v));
   std::vector<uint8_t> mesh_bytes;
+  std::shared_ptr<const SurfaceDistance> surface;
   if (v->label && v->label->kind == RegionLabel::Kind::kSurfaceShell) {
     const json& ms = spec["regions"]["mesh"];
     const std::string mesh_id = ms["id"].get<std::string>();
     SOLIDTEX_RETURN_IF_ERROR(impl_->meshes.mesh(mesh_id).status());  // 404 when unknown
     SOLIDTEX_ASSIGN_OR_RETURN(mesh_bytes, impl_->store.read(ResourceKind::kMesh, mesh_id, "source.mesh"));
-    SOLIDTEX_RETURN_IF_ERROR(impl_->attach_surface(*v, ms, mesh_bytes));
+    SOLIDTEX_ASSIGN_OR_RETURN(surface, impl_->build_surface(*v, ms, mesh_bytes));
   }
   const std::string id = DataStore::new_id("vol_");
   SOLIDTEX_RETURN_IF_ERROR(impl_->store.create(ResourceKind::kVolume, id));
@@ -325,7 +513,7 @@ Result<json> VolumeService::create(const std::string& spec_text) {
              {"exemplars", v->exemplar_ids},
              {"label", spec.contains("regions") ? spec["regions"]["label"] : json("")},
              {"field", field_desc},
-             {"field_description", v->field->describe()},
+             {"field_description", field->describe()},
              {"seed", v->seed},
              {"params", v->params_spec},
              {"spec", spec}};
@@ -336,8 +524,17 @@ Result<json> VolumeService::create(const std::string& spec_text) {
     impl_->store.remove(ResourceKind::kVolume, id);
     return st;
   }
-  std::lock_guard<std::mutex> g(impl_->mutex);
-  impl_->volumes.emplace(id, v);
+  {
+    std::lock_guard<std::mutex> g(impl_->mutex);
+    impl_->volumes.emplace(id, v);
+    impl_->touch(*v);
+  }
+  if (surface) {
+    // The band was built to check the label: keep it as the volume's loaded state rather than
+    // building it again at the first query (a failure here is reported by that query instead).
+    std::lock_guard<std::mutex> b(v->build_mutex);
+    if (auto built = impl_->build_state(*v, surface, field)) impl_->install(v, *built, false);
+  }
   json out = v->info;
   out.erase("spec");
   return out;
@@ -362,13 +559,17 @@ json VolumeService::list() const {
 }
 
 Status VolumeService::remove(const std::string& id) {
+  std::shared_ptr<VolumeState> dropped;
   {
     std::lock_guard<std::mutex> g(impl_->mutex);
     auto it = impl_->volumes.find(id);
     if (it == impl_->volumes.end()) return Status(StatusCode::kNotFound, "no volume '" + id + "'", "id");
     SOLIDTEX_RETURN_IF_ERROR(impl_->store.remove(ResourceKind::kVolume, id));
-    impl_->volumes.erase(it);  // running queries keep their shared_ptr until they finish
+    dropped = std::move(it->second->state);  // running queries keep their shared_ptr until they finish
+    it->second->state.reset();
+    impl_->volumes.erase(it);
   }
+  dropped.reset();
   impl_->rebalance_cache();
   return Status::ok();
 }
@@ -394,17 +595,22 @@ Result<QueryResult> VolumeService::query(const std::string& id, const std::strin
                                          Interrupter& interrupter) {
   SOLIDTEX_RETURN_IF_ERROR(check_target_size(int64_t(target.sample.size()), "size"));
   SOLIDTEX_ASSIGN_OR_RETURN(auto v, impl_->find(id));
-  SOLIDTEX_RETURN_IF_ERROR(impl_->build(*v));
+  SOLIDTEX_ASSIGN_OR_RETURN(std::shared_ptr<VolumeState> state, impl_->acquire(v));
+  struct Release {
+    Impl& impl;
+    Volume& v;
+    ~Release() { impl.release(v); }
+  } release{*impl_, *v};
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<SynthesisStats> per_region;
   QueryResult out;
   SynthesisOptions options;
   options.max_bytes = impl_->config.max_request_bytes;
-  if (v->regions) {
-    SOLIDTEX_ASSIGN_OR_RETURN(out.rgb, v->regions->synthesize(target, interrupter, &per_region, options));
+  if (state->regions) {
+    SOLIDTEX_ASSIGN_OR_RETURN(out.rgb, state->regions->synthesize(target, interrupter, &per_region, options));
   } else {
     per_region.resize(1);
-    SOLIDTEX_ASSIGN_OR_RETURN(out.rgb, v->synths[0]->synthesize(target, interrupter, &per_region[0], options));
+    SOLIDTEX_ASSIGN_OR_RETURN(out.rgb, state->synths[0]->synthesize(target, interrupter, &per_region[0], options));
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   for (const SynthesisStats& s : per_region) out.voxels_synthesized += s.voxels;
@@ -424,31 +630,43 @@ Result<QueryResult> VolumeService::query(const std::string& id, const std::strin
 
 Result<json> VolumeService::stats(const std::string& id) const {
   SOLIDTEX_ASSIGN_OR_RETURN(auto v, impl_->find(id));
-  std::vector<std::shared_ptr<Synthesizer>> synths;
+  std::shared_ptr<VolumeState> st;
+  json state;
   {
-    std::lock_guard<std::mutex> g(v->build_mutex);
-    synths = v->synths;
+    std::lock_guard<std::mutex> g(impl_->mutex);
+    st = v->state;
+    state = {{"loaded", bool(st)},
+             {"bytes", st ? st->bytes() : 0},
+             {"synthesizer_bytes", st ? st->synthesizer_bytes : 0},
+             {"table_bytes", st ? st->tables_bytes() : 0},
+             {"field_bytes", st ? st->field_bytes : 0},
+             {"surface_bytes", st ? st->surface_bytes : 0},
+             {"active_requests", v->active},
+             {"loads", v->loads},
+             {"evictions", v->evictions},
+             {"idle_seconds", v->active > 0 ? 0.0 : std::chrono::duration<double>(Clock::now() - v->last_used).count()}};
   }
   json cache = {{"bytes", 0}, {"budget_bytes", 0}, {"hits", 0}, {"misses", 0}, {"bricks", 0}, {"evicted_bricks", 0}};
   std::vector<int64_t> cached;
-  for (const auto& s : synths) {
-    const VoxelCache::Counters c = s->cache().counters();
-    cache["bytes"] = cache["bytes"].get<int64_t>() + c.bytes;
-    cache["budget_bytes"] = cache["budget_bytes"].get<int64_t>() + s->cache().budget_bytes();
-    cache["hits"] = cache["hits"].get<int64_t>() + c.hits;
-    cache["misses"] = cache["misses"].get<int64_t>() + c.misses;
-    cache["bricks"] = cache["bricks"].get<int64_t>() + c.bricks;
-    cache["evicted_bricks"] = cache["evicted_bricks"].get<int64_t>() + c.evicted_bricks;
-    if (cached.size() < c.voxels_per_level.size()) cached.resize(c.voxels_per_level.size(), 0);
-    for (size_t l = 0; l < c.voxels_per_level.size(); ++l) cached[l] += c.voxels_per_level[l];
-  }
+  if (st)
+    for (const auto& s : st->synths) {
+      const VoxelCache::Counters c = s->cache().counters();
+      cache["bytes"] = cache["bytes"].get<int64_t>() + c.bytes;
+      cache["budget_bytes"] = cache["budget_bytes"].get<int64_t>() + s->cache().budget_bytes();
+      cache["hits"] = cache["hits"].get<int64_t>() + c.hits;
+      cache["misses"] = cache["misses"].get<int64_t>() + c.misses;
+      cache["bricks"] = cache["bricks"].get<int64_t>() + c.bricks;
+      cache["evicted_bricks"] = cache["evicted_bricks"].get<int64_t>() + c.evicted_bricks;
+      if (cached.size() < c.voxels_per_level.size()) cached.resize(c.voxels_per_level.size(), 0);
+      for (size_t l = 0; l < c.voxels_per_level.size(); ++l) cached[l] += c.voxels_per_level[l];
+    }
   std::lock_guard<std::mutex> g(v->stats_mutex);
   json levels = json::array();
   for (size_t l = 0; l < std::max(cached.size(), v->voxels_per_level.size()); ++l)
     levels.push_back({{"level", l},
                       {"voxels_synthesized", l < v->voxels_per_level.size() ? v->voxels_per_level[l] : 0},
                       {"cached_voxels", l < cached.size() ? cached[l] : 0}});
-  return json{{"volume", id}, {"levels", levels}, {"cache", cache}, {"requests", v->requests},
+  return json{{"volume", id}, {"levels", levels}, {"cache", cache}, {"state", state}, {"requests", v->requests},
               {"recent", json(std::vector<json>(v->recent.begin(), v->recent.end()))}};
 }
 
@@ -456,6 +674,18 @@ int64_t VolumeService::cache_bytes() const {
   int64_t bytes = 0;
   for (auto& s : impl_->live_synthesizers()) bytes += s->cache().counters().bytes;
   return bytes;
+}
+
+VolumeStateTotals VolumeService::state_totals() const {
+  std::lock_guard<std::mutex> g(impl_->mutex);
+  VolumeStateTotals t;
+  t.bytes = impl_->state_bytes_locked();
+  t.budget_bytes = impl_->config.volume_state_bytes;
+  for (const auto& [id, v] : impl_->volumes) t.loaded += v->state ? 1 : 0;
+  t.loads = impl_->loads_total;
+  t.evicted_budget = impl_->evicted_budget;
+  t.evicted_idle = impl_->evicted_idle;
+  return t;
 }
 
 int64_t VolumeService::voxels_synthesized() const { return impl_->voxels_total.load(); }

@@ -3,10 +3,16 @@
 //
 // A volume is immutable: volume.json keeps the spec as given, and a stored field is copied
 // into the volume (field.stf) at creation, and so is the mesh of a surface-distance label
-// (mesh.source; regions {"label": "surface:D", "mesh": {"id", "placement"}}). Synthesizers (and their voxel caches) are built at
-// the first query and kept; the service-wide cache budget (--cache-mb) is split evenly over
-// the live synthesizers. Because synthesis is spatially deterministic, a query answers the
-// same bits whichever request, order, thread count or cache state computed its voxels, and the
+// (mesh.source; regions {"label": "surface:D", "mesh": {"id", "placement"}}).
+// Loaded state: what a volume keeps between queries outside its voxel cache (its tables, its
+// field, a surface label's distance band, its synthesizers and their voxel caches) is built at
+// its first query (a surface volume's at creation, which builds the band anyway) and counted
+// (stats()' "state"; state_totals()). Loaded volumes are evicted least recently used first when
+// their total passes --volume-state-mb, and when idle for --idle-evict-s; a state that a running
+// request uses is never evicted (requests hold it by shared_ptr). An evicted volume is rebuilt
+// at its next query. The service-wide cache budget (--cache-mb) is split evenly over the live
+// synthesizers. Because synthesis is spatially deterministic, a query answers the same bits
+// whichever request, order, thread count, cache state or eviction computed its voxels, and the
 // same as `solidtex slice` with the same table, field, parameters and seed.
 // Thread-safe: queries on one volume run concurrently (the synthesizer is thread-safe).
 #pragma once
@@ -34,6 +40,15 @@ struct QueryResult {
   nlohmann::json stats;                   // this request's entry in stats()' "recent"
 };
 
+// Loaded volumes over the whole service (/metrics).
+struct VolumeStateTotals {
+  int64_t bytes = 0;         // resident state of the loaded volumes (a shared table counts once)
+  int64_t budget_bytes = 0;  // --volume-state-mb
+  int64_t loaded = 0;        // volumes whose state is loaded
+  int64_t loads = 0;         // states built since start
+  int64_t evicted_budget = 0, evicted_idle = 0;  // evictions since start, by reason
+};
+
 class VolumeService {
  public:
   VolumeService(DataStore& store, const ServerConfig& config, ExemplarService& exemplars, FieldService& fields,
@@ -56,6 +71,7 @@ class VolumeService {
 
   int64_t cache_bytes() const;
   int64_t voxels_synthesized() const;
+  VolumeStateTotals state_totals() const;
 
  private:
   struct Impl;

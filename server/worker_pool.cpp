@@ -12,7 +12,8 @@ struct WorkerPool::Queue {
   std::mutex submit_mutex;  // makes "check stopping, then push" atomic with shutdown()
 };
 
-WorkerPool::WorkerPool(int workers, int queue_capacity) : queue_(std::make_unique<Queue>()), capacity_(queue_capacity) {
+WorkerPool::WorkerPool(int workers, int queue_capacity, Task when_idle)
+    : queue_(std::make_unique<Queue>()), capacity_(queue_capacity), when_idle_(std::move(when_idle)) {
   // The sentinels need room too, so the TBB capacity is queue + workers; try_submit enforces
   // the user-visible capacity itself.
   queue_->tasks.set_capacity(std::ptrdiff_t(queue_capacity + workers));
@@ -52,7 +53,8 @@ void WorkerPool::work() {
     --queued_;
     ++running_;
     task();
-    --running_;
+    task = Task();  // the request's captures go before the idle hook runs
+    if (--running_ == 0 && queued_.load() == 0 && when_idle_) when_idle_();
   }
 }
 

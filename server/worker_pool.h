@@ -2,7 +2,9 @@
 // `workers` threads take tasks from a TBB concurrent_bounded_queue of capacity `queue`:
 // try_submit() never blocks; it fails at once when `queue` tasks are already waiting (the
 // server answers 503 + Retry-After) or the pool is shutting down. Tasks themselves may use TBB
-// parallelism (the synthesizer does). Thread-safe.
+// parallelism (the synthesizer does). `when_idle`, if given, runs on the worker that finishes
+// the last running task while none is queued (the server returns freed memory to the system
+// there). Thread-safe.
 #pragma once
 
 #include <atomic>
@@ -16,7 +18,7 @@ namespace solidtex::server {
 class WorkerPool {
  public:
   using Task = std::function<void()>;
-  WorkerPool(int workers, int queue_capacity);
+  WorkerPool(int workers, int queue_capacity, Task when_idle = {});
   ~WorkerPool();  // shutdown()
   WorkerPool(const WorkerPool&) = delete;
   WorkerPool& operator=(const WorkerPool&) = delete;
@@ -39,6 +41,7 @@ class WorkerPool {
   std::atomic<int> running_{0};
   std::atomic<bool> stopping_{false};
   int capacity_;
+  Task when_idle_;
 };
 
 }  // namespace solidtex::server

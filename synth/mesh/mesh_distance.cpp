@@ -64,6 +64,12 @@ Result<std::shared_ptr<const SurfaceDistance>> SurfaceDistance::create(const Mes
   return std::shared_ptr<const SurfaceDistance>(d);
 }
 
+int64_t SurfaceDistance::resident_bytes() const {
+  int64_t bytes = int64_t(sizeof(SurfaceDistance)) + int64_t(sizeof(Impl));
+  if (impl_ && impl_->grid) bytes += int64_t(impl_->grid->memUsage());
+  return bytes;
+}
+
 double SurfaceDistance::at(const WorldPoint& p) const {
   // Voxel-centred samples: world point (i, j, k) is grid voxel (i, j, k); in between, trilinear.
   const openvdb::Vec3d xyz(p.x, p.y, p.z);

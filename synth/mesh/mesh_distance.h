@@ -28,6 +28,8 @@ class SurfaceDistance {
   // Distance in world units from p to the surface; > band() when farther than the band.
   double at(const WorldPoint& p) const;
   double band() const { return band_; }
+  // Memory the band holds (its OpenVDB tree, exactly as OpenVDB counts it, plus this object).
+  int64_t resident_bytes() const;
 
  private:
   SurfaceDistance() = default;

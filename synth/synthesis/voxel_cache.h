@@ -1,11 +1,12 @@
 // The sparse voxel cache: final coordinate triples of every pyramid level, kept across
-// requests in OpenVDB Vec3i grids (one grid per level; each int32 packs one plane's 16-bit
-// exemplar x and y), so storage comes in 8^3 leaf bricks. Only final versions are cached;
-// by the purity invariant a cached value equals what any request would compute.
+// requests in 8^3 bricks (a hash map of bricks per level; each voxel packs one plane's 16-bit
+// exemplar x and y per int32). Only final versions are cached; by the purity invariant a
+// cached value equals what any request would compute.
 //
-// Budget: when the grids' leaf bytes exceed `budget_bytes`, least-recently-used leaves are
+// Budget: `bytes` is everything the cache holds, brick_bytes() per brick (values, presence
+// bits, the map node and its bucket), with no other structure beside the bricks, so the budget
+// bounds the cache's real memory. When it exceeds `budget_bytes`, least-recently-used bricks are
 // dropped until usage is under 90% of the budget. Thread-safe: one mutex; callers batch.
-// Only voxel_cache.cpp includes OpenVDB.
 #pragma once
 
 #include <atomic>
@@ -40,9 +41,12 @@ class VoxelCache {
   void insert(PyramidLevel level, const std::vector<Voxel>& voxels, const std::vector<CoordinateTriple>& triples);
   void clear();
   Counters counters() const;
+  // Memory of one brick: Counters::bytes is bricks x brick_bytes().
+  static int64_t brick_bytes();
   int64_t budget_bytes() const { return budget_.load(); }
-  // Changes the budget; takes effect (evicting if needed) at the next insert.
-  void set_budget_bytes(int64_t bytes) { budget_.store(bytes); }
+  // Changes the budget, evicting at once (least recently used first, down to 90% of it) when
+  // the cache holds more, so that lowering every share keeps the sum of the budgets a bound.
+  void set_budget_bytes(int64_t bytes);
 
  private:
   struct Impl;

@@ -190,25 +190,56 @@ TEST(VoxelCache, EvictionIsLeastRecentlyUsedAcrossLevels) {
   EXPECT_EQ(k.voxels_per_level[1], 4);
 }
 
-TEST(VoxelCache, LoweringTheBudgetEvictsAtTheNextInsert) {
+TEST(VoxelCache, LoweringTheBudgetEvictsAtOnce) {
   const int64_t leaf = one_brick_bytes();
   VoxelCache c(1, 100 * leaf);
   EXPECT_EQ(c.budget_bytes(), 100 * leaf);
   for (int i = 0; i < 10; ++i)
     c.insert(PyramidLevel{0}, brick({8 * i - 40, 0, 0}), triples_for(brick({8 * i - 40, 0, 0}), 0));
   EXPECT_EQ(c.counters().bricks, 10);
-  c.set_budget_bytes(5 * leaf);
+  c.set_budget_bytes(5 * leaf);  // a service lowering every volume's share: no insert needed
   EXPECT_EQ(c.budget_bytes(), 5 * leaf);
-  EXPECT_EQ(c.counters().bricks, 10);  // not before the next insert
-  c.insert(PyramidLevel{0}, brick({0, 64, 0}), triples_for(brick({0, 64, 0}), 0));
-  const auto k = c.counters();
+  auto k = c.counters();
   EXPECT_LE(k.bytes, 5 * leaf * 9 / 10);
   EXPECT_EQ(k.bricks, 4);
-  EXPECT_EQ(k.evicted_bricks, 7);
-  // The newest bricks survive: the one just inserted and the three inserted last before it.
+  EXPECT_EQ(k.evicted_bricks, 6);
+  // The newest bricks survive: the four inserted last.
+  for (int i = 6; i < 10; ++i) EXPECT_EQ(found_count(c, 0, brick({8 * i - 40, 0, 0})), 4) << i;
+  for (int i = 0; i < 6; ++i) EXPECT_EQ(found_count(c, 0, brick({8 * i - 40, 0, 0})), 0) << i;
+  // Room for one more under the new budget; the next beyond it evicts the oldest again.
+  c.insert(PyramidLevel{0}, brick({0, 64, 0}), triples_for(brick({0, 64, 0}), 0));
+  EXPECT_EQ(c.counters().bricks, 5);
+  c.insert(PyramidLevel{0}, brick({0, 72, 0}), triples_for(brick({0, 72, 0}), 0));
+  k = c.counters();
+  EXPECT_EQ(k.bricks, 4);
+  EXPECT_EQ(k.evicted_bricks, 8);
+  EXPECT_EQ(found_count(c, 0, brick({0, 72, 0})), 4);
   EXPECT_EQ(found_count(c, 0, brick({0, 64, 0})), 4);
-  for (int i = 7; i < 10; ++i) EXPECT_EQ(found_count(c, 0, brick({8 * i - 40, 0, 0})), 4) << i;
-  for (int i = 0; i < 7; ++i) EXPECT_EQ(found_count(c, 0, brick({8 * i - 40, 0, 0})), 0) << i;
+  EXPECT_EQ(found_count(c, 0, brick({16, 0, 0})), 0);  // i = 6 and 7 went (looked up first)
+}
+
+TEST(VoxelCache, BricksFarApartAreDistinctAndEachCostsOneBrick) {
+  // Coordinates that agree in their low 24 bits, up to the lattice's +-2^28: no two share a
+  // brick (or its LRU entry), and scattered bricks cost what adjacent ones cost.
+  const std::vector<Voxel> v = {{0, 0, 0},           {1 << 24, 0, 0},       {0, -(1 << 24), 0},
+                                {0, 0, (1 << 28) - 1}, {-(1 << 28), 0, 0}, {(1 << 28) - 1, -(1 << 28), 1 << 27}};
+  VoxelCache c(1, int64_t(1) << 30);
+  c.insert(PyramidLevel{0}, v, triples_for(v, 0));
+  auto k = c.counters();
+  EXPECT_EQ(k.bricks, int64_t(v.size()));
+  EXPECT_EQ(k.bytes, int64_t(v.size()) * VoxelCache::brick_bytes());
+  std::vector<CoordinateTriple> out;
+  std::vector<uint8_t> found;
+  ASSERT_EQ(c.lookup(PyramidLevel{0}, v, out, found), int64_t(v.size()));
+  for (size_t i = 0; i < v.size(); ++i) EXPECT_EQ(out[i], triple_for(v[i], 0)) << i;
+  // A budget of two bricks keeps the two used last, whatever their coordinates.
+  c.set_budget_bytes(2 * VoxelCache::brick_bytes() + VoxelCache::brick_bytes() / 2);
+  EXPECT_EQ(found_count(c, 0, {v[1]}), 1);
+  c.insert(PyramidLevel{0}, {v[4]}, {triple_for(v[4], 0)});
+  k = c.counters();
+  EXPECT_EQ(k.bricks, 2);
+  EXPECT_EQ(found_count(c, 0, {v[1], v[4]}), 2);
+  EXPECT_EQ(found_count(c, 0, {v[0], v[2], v[3], v[5]}), 0);
 }
 
 TEST(VoxelCache, ZeroBudgetCachesNothing) {

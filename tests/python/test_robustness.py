@@ -243,6 +243,36 @@ def test_huge_blank_png_is_refused_by_the_analysis_cost_model(srv, tmp_path):
     alive(srv)
 
 
+def test_several_huge_blank_planes_are_refused_after_decoding_one(srv, tmp_path):
+    """Six 4096^2 blank PNGs (xy, yz, zx and their masks) are about 100 KB on the wire but 1.2 GB
+    as float pixels: the cost model refuses them after the first image, not after all six."""
+    path = tmp_path / "blank.png"
+    Image.new("RGB", (4096, 4096)).save(path)
+    data = path.read_bytes()
+    names = ("xy", "yz", "zx", "mask", "mask_yz", "mask_zx")
+    status = Path(f"/proc/{srv.proc.pid}/status")
+    clear = Path(f"/proc/{srv.proc.pid}/clear_refs")
+    try:
+        clear.write_text("5")  # resets VmHWM to the current RSS
+        measured = True
+    except OSError:
+        measured = False
+
+    def rss(key: str) -> int:
+        for line in status.read_text().splitlines():
+            if line.startswith(key + ":"):
+                return int(line.split()[1]) << 10
+        raise AssertionError(key)
+
+    before = rss("VmRSS")
+    r = requests.post(f"{srv.url}/v1/exemplars", files=[(n, (n + ".png", data)) for n in names], timeout=HTTP_TIMEOUT)
+    err = assert_error(r, 422, field_contains="xy")
+    assert "--max-request-mb" in err["message"], err
+    if measured:  # one decoded 4096^2 image and its decoder's buffers, not six
+        assert rss("VmHWM") - before < 700 << 20, (rss("VmHWM") - before) >> 20
+    alive(srv)
+
+
 CUBE_OFF = b"""OFF
 8 12 0
 0 0 0
