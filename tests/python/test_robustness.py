@@ -179,6 +179,23 @@ def test_raw_0xff_in_the_path_is_a_4xx(srv):
     alive(srv)
 
 
+@pytest.mark.parametrize("method", [b"QUERY", b"FROB", b"G\xffT"])
+def test_unknown_http_methods_leave_the_server_up(srv, method):
+    # RESTinio's http_parser refuses methods it does not know by closing the connection
+    # before any handler runs (README, limits): no status, but never a crash or a hang.
+    host, port = srv.url.split("//", 1)[1].split(":")
+    with socket.create_connection((host, int(port)), timeout=10) as sock:
+        sock.sendall(method + b" /v1/volumes HTTP/1.1\r\nHost: x\r\nContent-Length: 0\r\n\r\n")
+        answer = b""
+        while True:
+            chunk = sock.recv(4096)
+            if not chunk:
+                break
+            answer += chunk
+    assert answer == b"" or answer.startswith(b"HTTP/1.1 4"), answer[:200]
+    alive(srv)
+
+
 def slow_exemplar(tmp_path: Path) -> bytes:
     """A 160x160 noise exemplar: its default analysis takes seconds on 2 cores."""
     rng = np.random.default_rng(5)
