@@ -37,7 +37,7 @@ from PIL import Image  # noqa: E402
 
 import support  # noqa: E402
 from support import HTTP_TIMEOUT, RAW_F32, ServerFactory, post_bytes, raw_post  # noqa: E402
-import test_robustness as probes  # noqa: E402  (create_volume, slice_of, big_sketch, slow_exemplar, CUBE_OFF)
+import test_robustness as probes  # noqa: E402  (create_volume, slice_of, big_sketch, slow_exemplar)
 
 # The documented fixed budget above --cache-mb (README, "Memory"): what the process holds beside
 # the voxel cache under every probe below with the default limits: code and libraries, allocator
@@ -340,7 +340,7 @@ def main() -> None:
                 subprocess.run([str(build / "bin" / "solidtex"), "exemplar", kind, "--size", "64,64", "-o", str(path)],
                                check=True, capture_output=True)
                 s.small_exemplars.append(support.upload_ready(srv.client, path)["id"])
-            s.cube = post_bytes(f"{srv.url}/v1/meshes", probes.CUBE_OFF, params={"name": "cube"}).json()["id"]
+            s.cube = post_bytes(f"{srv.url}/v1/meshes", support.CUBE_OFF, params={"name": "cube"}).json()["id"]
             seeds = iter(range(1000, 100000))
             s.new_volume = lambda seed=None: probes.create_volume(s, seed=seed if seed is not None else next(seeds)).json()["id"]
             out["after_setup_rss_mb"] = mb(read_status(srv.proc.pid)["VmRSS"])

@@ -6,6 +6,7 @@
 // broken invariant aborts via FUZZ_CHECK, which libFuzzer records as a crash with its input.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -42,6 +43,14 @@ inline std::vector<uint8_t> with_valid_checksum(std::span<const uint8_t> file) {
   for (int f = 0; f < 2; ++f)
     for (int i = 0; i < 8; ++i) out[16 + size_t(f) * 8 + size_t(i)] = uint8_t(fields[f] >> (8 * i));
   return out;
+}
+
+// Runs `check` on the input as given, then on its checksum-fixed copy when that differs.
+template <class Check>
+void as_given_and_with_valid_checksum(const uint8_t* data, size_t size, Check&& check) {
+  check(bytes(data, size));
+  const std::vector<uint8_t> fixed = with_valid_checksum(bytes(data, size));
+  if (!fixed.empty() && !std::equal(fixed.begin(), fixed.end(), data)) check(std::span<const uint8_t>(fixed));
 }
 
 }  // namespace solidtex::fuzz

@@ -60,8 +60,6 @@ void decode_and_check(std::span<const uint8_t> file) {
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  decode_and_check(fuzz::bytes(data, size));
-  const std::vector<uint8_t> fixed = fuzz::with_valid_checksum(fuzz::bytes(data, size));
-  if (!fixed.empty() && !std::equal(fixed.begin(), fixed.end(), data)) decode_and_check(fixed);
+  fuzz::as_given_and_with_valid_checksum(data, size, decode_and_check);
   return 0;
 }

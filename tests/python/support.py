@@ -340,3 +340,29 @@ def metric_lines(text: str, name: str) -> List[str]:
         if line.startswith(name + " ") or line.startswith(name + "{"):
             out.append(line)
     return out
+
+
+# A closed unit cube (12 triangles), the smallest valid mesh upload.
+CUBE_OFF = b"""OFF
+8 12 0
+0 0 0
+1 0 0
+1 1 0
+0 1 0
+0 0 1
+1 0 1
+1 1 1
+0 1 1
+3 0 2 1
+3 0 3 2
+3 4 5 6
+3 4 6 7
+3 0 1 5
+3 0 5 4
+3 2 3 7
+3 2 7 6
+3 1 2 6
+3 1 6 5
+3 0 4 7
+3 0 7 3
+"""

@@ -13,7 +13,7 @@ import pytest
 import requests
 from PIL import Image
 
-from support import ANALYSIS, HTTP_TIMEOUT, RAW, RAW_F32, ServerFactory, assert_error, post_bytes, upload_ready
+from support import CUBE_OFF, ANALYSIS, HTTP_TIMEOUT, RAW, RAW_F32, ServerFactory, assert_error, post_bytes, upload_ready
 
 
 @pytest.fixture(scope="module")
@@ -288,31 +288,6 @@ def test_several_huge_blank_planes_are_refused_after_decoding_one(srv, tmp_path)
     if measured:  # one decoded 4096^2 image and its decoder's buffers, not six
         assert rss("VmHWM") - before < 700 << 20, (rss("VmHWM") - before) >> 20
     alive(srv)
-
-
-CUBE_OFF = b"""OFF
-8 12 0
-0 0 0
-1 0 0
-1 1 0
-0 1 0
-0 0 1
-1 0 1
-1 1 1
-0 1 1
-3 0 2 1
-3 0 3 2
-3 4 5 6
-3 4 6 7
-3 0 1 5
-3 0 5 4
-3 2 3 7
-3 2 7 6
-3 1 2 6
-3 1 6 5
-3 0 4 7
-3 0 7 3
-"""
 
 
 def test_surface_band_beyond_the_memory_limit_is_refused_at_creation(srv):

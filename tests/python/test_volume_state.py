@@ -13,7 +13,7 @@ from typing import Dict
 import pytest
 import requests
 
-from support import HTTP_TIMEOUT, RAW_F32, ServerFactory, metric_lines, post_bytes, upload_ready
+from support import CUBE_OFF, HTTP_TIMEOUT, RAW_F32, ServerFactory, metric_lines, post_bytes, upload_ready
 
 MB = 1 << 20
 # Each 64x64 exemplar's table (3 levels) is about 4 MB decoded: the budget holds two volumes.
@@ -167,31 +167,6 @@ def test_a_running_request_keeps_its_state(budget, tmp_path):
     assert not state(s, fresh)["loaded"]
     assert slice_bytes(s, fresh, size="96,96") == out["bytes"]
     assert metrics(s)["solidtex_volume_state_bytes"] <= BUDGET_MB * MB
-
-
-CUBE_OFF = b"""OFF
-8 12 0
-0 0 0
-1 0 0
-1 1 0
-0 1 0
-0 0 1
-1 0 1
-1 1 1
-0 1 1
-3 0 2 1
-3 0 3 2
-3 4 5 6
-3 4 6 7
-3 0 1 5
-3 0 5 4
-3 2 3 7
-3 2 7 6
-3 1 2 6
-3 1 6 5
-3 0 4 7
-3 0 7 3
-"""
 
 
 def test_idle_volumes_are_evicted_and_rebuilt(server, exemplars):
