@@ -3,6 +3,7 @@
 Embark's 2D texture-synthesis on the same exemplar and size.
 
   bench_quality.py BUILD [--size 256] [--exemplars a.png,b.png] [--out DIR] [--no-embark]
+                  [--typicality T]   (synthesis' typicality weight; default: the CLI's default)
 
 For every exemplar in ../shared/data/exemplars (wood_grain and wood_planks analysed with
 --grain x, the rest with defaults): z, y and x cuts and one oblique cut of SIZE^2 through the
@@ -69,6 +70,7 @@ def main() -> int:
     ap.add_argument("--exemplars", default="")
     ap.add_argument("--out", type=Path, default=None)
     ap.add_argument("--no-embark", action="store_true")
+    ap.add_argument("--typicality", type=float, default=None)
     args = ap.parse_args()
     build = args.build.resolve()
     solidtex = build / "bin" / "solidtex"
@@ -101,7 +103,8 @@ def main() -> int:
                 image = out_dir / f"{name}_{cut}.png"
                 stats = tmp / f"{name}_{cut}.json"
                 t0 = time.monotonic()
-                run([solidtex, "slice", table, *where, "--size", f"{n},{n}", "-o", image, "--stats", stats])
+                tuning = [] if args.typicality is None else ["--typicality", args.typicality]
+                run([solidtex, "slice", table, *where, "--size", f"{n},{n}", *tuning, "-o", image, "--stats", stats])
                 seconds = time.monotonic() - t0
                 scores = texmetric(python, image, ex)
                 scores["seconds"] = round(seconds, 2)
@@ -129,7 +132,7 @@ def main() -> int:
     if ratios:
         summary.update({"median_worst_swd_over_embark": float(np.median(ratios)),
                         "max_worst_swd_over_embark": float(np.max(ratios))})
-    print(json.dumps({"size": n, "montages": str(out_dir), "exemplars": results, "summary": summary}, indent=1))
+    print(json.dumps({"size": n, "typicality": args.typicality, "montages": str(out_dir), "exemplars": results, "summary": summary}, indent=1))
     return 0
 
 

@@ -59,7 +59,8 @@ Result<TargetSet> parse_cut(const Args& args) {
 
 Status run_slice(const std::vector<std::string>& argv) {
   Args args({"-o", "--axis", "--at", "--origin", "--plane", "--size", "--scheme", "--field", "--seed", "--threads",
-             "--stats", "--passes", "--coarse-passes", "--cell", "--cache-mb", "--plane-weights", "--matcher", "--region-table", "--regions"},
+             "--stats", "--passes", "--coarse-passes", "--cell", "--cache-mb", "--plane-weights", "--matcher", "--region-table", "--regions",
+             "--typicality"},
             {"--energy"});
   SOLIDTEX_RETURN_IF_ERROR(args.parse(argv));
   if (args.positionals().size() != 1)
@@ -83,6 +84,10 @@ Status run_slice(const std::vector<std::string>& argv) {
   if (args.has("--plane-weights")) {
     SOLIDTEX_ASSIGN_OR_RETURN(auto w, args.get_list("--plane-weights", 3));
     params.plane_weights = {float(w[0]), float(w[1]), float(w[2])};
+  }
+  if (args.has("--typicality")) {
+    SOLIDTEX_ASSIGN_OR_RETURN(auto t, args.get_list("--typicality", 1));
+    params.typicality = float(t[0]);
   }
   SOLIDTEX_RETURN_IF_ERROR(params.validate());
   SOLIDTEX_ASSIGN_OR_RETURN(int threads, args.get_int("--threads", 0, 0, 1024));

@@ -28,14 +28,14 @@ constexpr const char* kUsage =
     "          [--candidates 12] [--pca-dims 20] [--seed S] [--threads T] -o TABLE.stx [--json]\n"
     "  slice TABLE.stx (--axis x|y|z --at K [--origin U,V] | --plane OX,OY,OZ,UX,UY,UZ,VX,VY,VZ)\n"
     "          --size W,H [--scheme plain|subpass|grid|dual-grid] [--field identity|quat:W,X,Y,Z|FILE]\n"
-    "          [--seed S] [--threads T] -o OUT.png [--stats STATS.json]\n"
+    "          [--seed S] [--threads T] [--typicality 0.5] -o OUT.png [--stats STATS.json]\n"
     "  field SKETCH.json -o FIELD.stf [--json]\n"
     "  serve [--host 127.0.0.1] [--port 8080] [--data DIR] [--threads N] [--queue N] [--deadline S]\n"
     "          [--cache-mb M] [--max-upload-mb M] [--max-image-side PX] [--max-voxels N] [--max-jobs N]\n"
     "          [--max-request-mb 1536] [--volume-state-mb 512] [--idle-evict-s 300]\n"
     "          --volume-state-mb bounds loaded volumes' tables, fields, bands and synthesizers (LRU\n"
     "          eviction); --idle-evict-s evicts volumes idle that long (0: never); see README limits\n"
-    "  exemplar KIND -o FILE.png [--size W,H] [--seed S]     KIND: wood, stripes, bricks, noise, spots\n";
+    "  exemplar KIND -o FILE.png [--size W,H] [--seed S]     KIND: wood, stripes, bricks, noise, spots, pebbles\n";
 
 }  // namespace
 

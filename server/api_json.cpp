@@ -21,7 +21,7 @@ namespace {
 // validate() runs afterwards for the rules that involve several members.
 template <typename P>
 struct Param {
-  using Member = std::variant<int P::*, uint32_t P::*, std::array<float, 3> P::*, Scheme P::*, Matcher P::*>;
+  using Member = std::variant<int P::*, uint32_t P::*, float P::*, std::array<float, 3> P::*, Scheme P::*, Matcher P::*>;
   const char* key;
   Member member;
   int64_t lo = 0, hi = 0;
@@ -50,6 +50,7 @@ constexpr Param<SynthesisParams> kSynthesisParams[] = {
     {"init_subpart", &SynthesisParams::init_subpart, 8, 256},
     {"trilinear_levels", &SynthesisParams::trilinear_levels, 0, 8},
     {"plane_weights", &SynthesisParams::plane_weights, 0, 1},
+    {"typicality", &SynthesisParams::typicality, 0, 4},
 };
 
 template <typename... F>
@@ -81,6 +82,11 @@ Status read_param(const Param<P>& d, const json& v, const std::string& field, P&
           [&](uint32_t P::*m) -> Status {
             SOLIDTEX_ASSIGN_OR_RETURN(int64_t x, json_int(v, field, d.lo, d.hi));
             p.*m = uint32_t(x);
+            return Status::ok();
+          },
+          [&](float P::*m) -> Status {
+            SOLIDTEX_ASSIGN_OR_RETURN(double x, json_number(v, field, double(d.lo), double(d.hi)));
+            p.*m = float(x);
             return Status::ok();
           },
           [&](std::array<float, 3> P::*m) -> Status {

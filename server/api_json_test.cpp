@@ -31,7 +31,7 @@ TEST(ApiJson, WireFormatOfTheDefaults) {
             R"("suggested_plane_weights":[1.0,1.0,1.0]})");
   EXPECT_EQ(to_json(SynthesisParams{}).dump(),
             R"({"cell_size":12,"coarse_passes":3,"init_subpart":32,"matcher":"paper","passes":2,)"
-            R"("plane_weights":[1.0,1.0,1.0],"scheme":"dual-grid","subpass_size":2,"trilinear_levels":2})");
+            R"("plane_weights":[1.0,1.0,1.0],"scheme":"dual-grid","subpass_size":2,"trilinear_levels":2,"typicality":0.5})");
 }
 
 TEST(ApiJson, EveryKeyReadsBackWhatItWrites) {
@@ -58,11 +58,13 @@ TEST(ApiJson, EveryKeyReadsBackWhatItWrites) {
   s.init_subpart = 64;
   s.trilinear_levels = 0;
   s.plane_weights = {0.5f, 1.f, 0.f};
+  s.typicality = 1.25f;
   auto s2 = synthesis_params_from_json(to_json(s), "params", SynthesisParams{});
   ASSERT_TRUE(s2.is_ok()) << s2.status().to_string();
   EXPECT_EQ(to_json(*s2), to_json(s));
   EXPECT_EQ(s2->scheme, Scheme::kGrid);
   EXPECT_EQ(s2->plane_weights, s.plane_weights);
+  EXPECT_EQ(s2->typicality, 1.25f);
 }
 
 TEST(ApiJson, MissingKeysKeepTheBase) {
@@ -101,6 +103,8 @@ TEST(ApiJson, ErrorsNameTheField) {
       {{{"plane_weights", {1, 2, 1}}}, "params.plane_weights", "must be in [0.000000, 1.000000]"},
       {{{"plane_weights", {0, 0, 0}}}, "params.plane_weights", "must not all be zero"},  // validate()
       {{{"init_subpart", 9}}, "params.init_subpart", "must be even"},                    // validate()
+      {{{"typicality", 5}}, "params.typicality", "must be in [0.000000, 4.000000]"},
+      {{{"typicality", "high"}}, "params.typicality", "must be a number"},
   };
   for (const Case& c : synthesis) {
     const Status st = synthesis_error(c.j);

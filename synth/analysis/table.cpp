@@ -5,6 +5,7 @@
 
 #include "analysis/gaussian_stack.h"
 #include "analysis/neighborhood.h"
+#include "analysis/typicality.h"
 
 namespace solidtex {
 
@@ -46,6 +47,7 @@ Result<std::shared_ptr<const Table>> Table::assemble(AnalysisParams params, Exem
       app->stack = std::move(stack[size_t(L - 1 - l)]);
       app->pca = pca;
       app->projected = project_all_neighborhoods(app->stack, pca, params.neighborhood, spacing);
+      app->typicality = typicality_penalty(app->projected, pca.output_dims);
       for (int p = k; p < (distinct == 1 ? 3 : k + 1); ++p) table->levels_[l].planes[p] = app;
     }
   }

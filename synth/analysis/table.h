@@ -3,8 +3,8 @@
 //
 // Stored (in .stx): parameters, the matching images, per level and distinct image the PCA
 // basis, per level and plane the candidate triples, and per level the analysis statistics.
-// Derived on construction (not stored, reproduced bit for bit): Gaussian stacks and every
-// pixel's projected neighborhood ("appearance vector").
+// Derived on construction (not stored, reproduced bit for bit): Gaussian stacks, every
+// pixel's projected neighborhood ("appearance vector") and its typicality penalty.
 // Immutable once built; safe to share between threads.
 #pragma once
 
@@ -26,6 +26,7 @@ struct PlaneAppearance {
   ImageF stack;                   // Gaussian-stack matching image at this level's blur
   PcaBasis pca;                   // fitted on N x N neighborhoods at this level's spacing
   std::vector<float> projected;   // width*height rows of pca.output_dims: appearance vectors
+  std::vector<float> typicality;  // width*height penalties, >= 0 (typicality.h)
 
   const float* appearance(ExemplarPixel p) const {
     const size_t i = size_t(ImageF::wrap(p.y, stack.height)) * stack.width + ImageF::wrap(p.x, stack.width);

@@ -90,12 +90,12 @@ void output_color(const Table& table, const CoordinateTriple& t, const PlaneWeig
   for (int k = 0; k < 3; ++k) rgb[k] = w[0] * a[k] + w[1] * b[k] + w[2] * c[k];
 }
 
-CorrectionContext CorrectionContext::make(const Table& table, PyramidLevel l, const std::array<float, 3>& plane_weights,
-                                          bool coherent_matcher) {
+CorrectionContext CorrectionContext::make(const Table& table, PyramidLevel l, const SynthesisParams& params) {
   CorrectionContext ctx;
-  ctx.candidates_per_source = coherent_matcher ? 4 : 64;
-  ctx.cost_weights = plane_weights;
-  ctx.color_weights = normalised_weights(plane_weights);
+  ctx.candidates_per_source = params.matcher == Matcher::kCoherent ? 4 : 64;
+  ctx.cost_weights = params.plane_weights;
+  ctx.color_weights = normalised_weights(params.plane_weights);
+  ctx.typicality = params.typicality;
   ctx.level = &table.level(l);
   ctx.n = table.params().neighborhood;
   ctx.spacing = table.spacing(l);
@@ -146,8 +146,10 @@ CoordinateTriple best_candidate(const CorrectionContext& ctx, const CoordinateTr
     float cost = 0.f;
     for (int k = 0; k < 3 && cost <= best; ++k) {
       const PlaneAppearance& app = *level.planes[size_t(k)];
-      const float* a = &app.projected[(size_t(t.at[size_t(k)].y) * app.stack.width + size_t(t.at[size_t(k)].x)) * d];
-      cost += ctx.cost_weights[size_t(k)] * plane_distance(s.projected.data() + size_t(k) * d, a, d);
+      const size_t pixel = size_t(t.at[size_t(k)].y) * app.stack.width + size_t(t.at[size_t(k)].x);
+      float dk = plane_distance(s.projected.data() + size_t(k) * d, &app.projected[pixel * d], d);
+      if (ctx.typicality > 0.f) dk += ctx.typicality * app.typicality[pixel];
+      cost += ctx.cost_weights[size_t(k)] * dk;
     }
     if (cost < best || (cost == best && t < best_t)) {
       best = cost;

@@ -15,8 +15,11 @@
 // (a, b) in {-1,0,1}^2 the N_T table candidates of plane k at T_k(u) - h*(a, b), where
 // u = p + lround(R * local(a, b)) (the reduced d-set of §4.3). Matching: each plane's gathered
 // N x N x C vector is projected by that plane's PCA basis; a candidate's cost is the sum over
-// planes of squared distances to its stored appearance vectors. Lowest cost wins; equal costs
-// go to the lexicographically smallest triple. No randomness, fixed summation order.
+// planes of squared distances to its stored appearance vectors, each plus `typicality` times
+// the candidate pixel's typicality penalty (analysis/typicality.h: a pull away from the
+// exemplar's mean appearance, against the L2 match's collapse into smooth blobs). Lowest cost
+// wins; equal costs go to the lexicographically smallest triple. No randomness, fixed
+// summation order.
 //
 // Voxel color: the matching color of a triple is the mean over the three planes of that
 // level's Gaussian-stack color at T_k (RGB plus mask channel), weighted by the plane weights;
@@ -31,6 +34,7 @@
 #include "field/frame_field.h"
 #include "analysis/table.h"
 #include "core/types.h"
+#include "synthesis/synthesis_params.h"
 
 namespace solidtex {
 
@@ -74,8 +78,8 @@ struct CorrectionContext {
   PlaneWeights cost_weights{1.f, 1.f, 1.f};          // per-plane matching weights
   int candidates_per_source = 64;                    // table candidates tried per source pixel
   PlaneWeights color_weights{1.f / 3, 1.f / 3, 1.f / 3};
-  static CorrectionContext make(const Table& table, PyramidLevel l, const std::array<float, 3>& plane_weights,
-                                bool coherent_matcher);
+  float typicality = 0.f;                            // SynthesisParams::typicality
+  static CorrectionContext make(const Table& table, PyramidLevel l, const SynthesisParams& params);
 };
 
 struct CorrectionScratch {

@@ -37,7 +37,8 @@ int64_t table_resident_bytes(const Table& table) {
     for (const auto& app : level.planes)
       if (app && seen.insert(app.get()).second)
         bytes += int64_t(sizeof(PlaneAppearance)) + kBlockOverhead + vector_bytes(app->stack.pixels) +
-                 pca_bytes(app->pca) + vector_bytes(app->projected);
+                 pca_bytes(app->pca) + vector_bytes(app->projected) +
+                 vector_bytes(app->typicality);
     for (const PlaneCandidates& pc : level.candidates.planes) bytes += vector_bytes(pc.triples) + vector_bytes(pc.counts);
   }
   return bytes;
@@ -61,8 +62,7 @@ int64_t synthesizer_state_bytes(const Synthesizer& s) {
   // The synthesizer builds exactly these per level at creation (synthesizer.cpp): rebuild them
   // here to read their sizes.
   for (int l = 0; l < levels; ++l) {
-    const CorrectionContext ctx = CorrectionContext::make(table, PyramidLevel{l}, params.plane_weights,
-                                                          params.matcher == Matcher::kCoherent);
+    const CorrectionContext ctx = CorrectionContext::make(table, PyramidLevel{l}, params);
     bytes += int64_t(sizeof(CorrectionContext));
     for (const PcaProjection& p : ctx.projection) bytes += projection_bytes(p);
     const LevelSchedule& sch = s.schedule(PyramidLevel{l});

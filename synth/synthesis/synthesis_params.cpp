@@ -54,6 +54,8 @@ Status SynthesisParams::validate() const {
     total += w;
   }
   if (!(total > 0.f)) return Status(StatusCode::kInvalidArgument, "must not all be zero", "plane_weights");
+  if (!(typicality >= 0.f && typicality <= 4.f))
+    return Status(StatusCode::kInvalidArgument, "must be in [0, 4]", "typicality");
   return Status::ok();
 }
 

@@ -43,6 +43,11 @@ struct SynthesisParams {
   // not all zero. Zhang §6.1: a plane whose exemplar conflicts with the others in 3D (e.g.
   // the end grain of a wood exemplar) is best given a small weight.
   std::array<float, 3> plane_weights{1.f, 1.f, 1.f};
+  // Weight of the typicality penalty in matching costs (analysis/typicality.h), [0, 4]: how
+  // hard matches are pulled away from the exemplar's mean appearance. 0 is plain L2 matching
+  // (Zhang et al.), whose slices collapse into smooth blobs; 0.5 keeps pebbles, veins and
+  // weave crisp (bench/bench_quality.py); much above 1 favours extremes and noise.
+  float typicality = 0.5f;
 
   Status validate() const;
 };

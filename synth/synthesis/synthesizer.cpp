@@ -260,8 +260,7 @@ Result<std::shared_ptr<Synthesizer>> Synthesizer::create(std::shared_ptr<const T
                                                                     params.trilinear_levels));
   for (int l = 0; l < L; ++l) {
     s->schedules_.push_back(LevelSchedule::make(l, params));
-    s->impl_->contexts.push_back(CorrectionContext::make(*s->table_, PyramidLevel{l}, params.plane_weights,
-                                                         params.matcher == Matcher::kCoherent));
+    s->impl_->contexts.push_back(CorrectionContext::make(*s->table_, PyramidLevel{l}, params));
   }
   return s;
 }

@@ -3,6 +3,9 @@
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
+#include <cstdio>
+
 #include "analysis/analysis.h"
 #include "testkit/quality.h"
 #include "synthesis/region_volume.h"
@@ -224,17 +227,62 @@ TEST_F(SynthesizerTest, CorrectionLowersMatchingEnergyAndDualGridKeepsQuality) {
     }
     return e;
   };
-  SynthesisParams none = small_params(Scheme::kSubpass);
+  // Plain L2 matching, the objective energy measures; the typicality penalty trades some of it
+  // for crispness (SynthesizerQuality judges that with two-sided measures).
+  auto plain = [](Scheme scheme) {
+    SynthesisParams p = small_params(scheme);
+    p.typicality = 0.f;
+    return p;
+  };
+  SynthesisParams none = plain(Scheme::kSubpass);
   none.coarse_passes = 0;
   none.passes = 0;
   const double e_init = energy(none);
-  const double e_subpass = energy(small_params(Scheme::kSubpass));
-  const double e_dual = energy(small_params(Scheme::kDualGrid));
+  const double e_subpass = energy(plain(Scheme::kSubpass));
+  const double e_dual = energy(plain(Scheme::kDualGrid));
   RecordProperty("energy_init", std::to_string(e_init));
   RecordProperty("energy_subpass", std::to_string(e_subpass));
   RecordProperty("energy_dual_grid", std::to_string(e_dual));
   EXPECT_LT(e_subpass, 0.8 * e_init) << e_subpass << " vs init " << e_init;
   EXPECT_LT(e_dual, 1.1 * e_subpass) << e_dual << " vs subpass " << e_subpass;
+}
+
+// Two-sided quality, which sees blur, on procedural pebbles (small distinct stones in dark
+// gaps): coverage (every exemplar neighborhood finds a close one in the cut; fails when detail
+// or variety is missing) and sharpness (gradient energy over the exemplar's), for x, y and z
+// cuts. The references are the exemplar itself blurred: a cut as soft as a 1 px blur fails on
+// sharpness, one missing as much detail as a 2 px blur fails on coverage.
+TEST(SynthesizerQuality, CutsAreCrispAndCoverTheExemplarUnlikeABlurredCopy) {
+  const auto table = small_table(ProceduralKind::kPebbles, false);
+  const ImageF& exemplar = table->exemplars().plane(Plane::kXY);
+  const ImageF window = toroidal_crop(exemplar, 5, 9, 40, 40);
+  const double blur_sharp = sharpness_ratio(gaussian_blur(window, 1.0), exemplar);
+  const double blur_coverage = coverage(gaussian_blur(window, 2.0), exemplar, 7, 2);
+  auto scores = [&](float typicality, double& cov, double& min_sharp, double& max_sharp) {
+    SynthesisParams p = small_params();
+    p.typicality = typicality;
+    auto s = make(table, "identity", p, 0);
+    cov = 0, min_sharp = 1e9, max_sharp = 0;
+    for (char axis : {'x', 'y', 'z'}) {
+      const ImageF img = to_image(cut(*s, axis, 5, 0, 0, 40, 40), 40, 40);
+      cov = std::max(cov, coverage(img, exemplar, 7, 2));
+      min_sharp = std::min(min_sharp, sharpness_ratio(img, exemplar));
+      max_sharp = std::max(max_sharp, sharpness_ratio(img, exemplar));
+    }
+  };
+  double cov = 0, lo = 0, hi = 0, cov0 = 0, lo0 = 0, hi0 = 0;
+  scores(SynthesisParams{}.typicality, cov, lo, hi);
+  scores(0.f, cov0, lo0, hi0);
+  std::printf("blurred exemplar: coverage (2 px) %.4f, sharp (1 px) %.3f\ndefault: worst coverage %.4f sharp %.3f..%.3f\n"
+              "typicality 0: worst coverage %.4f sharp %.3f..%.3f\n",
+              blur_coverage, blur_sharp, cov, lo, hi, cov0, lo0, hi0);
+  RecordProperty("coverage_blurred_exemplar", std::to_string(blur_coverage));
+  RecordProperty("coverage_worst_cut", std::to_string(cov));
+  RecordProperty("sharp_min_cut", std::to_string(lo));
+  EXPECT_GT(lo, blur_sharp);
+  EXPECT_GT(lo, 0.8);
+  EXPECT_LT(hi, 1.3);  // crisp, not noise
+  EXPECT_LT(cov, blur_coverage);
 }
 
 TEST(SynthesizerOrientation, ConstantRotationTurnsTheGrain) {

@@ -111,9 +111,43 @@ void spots(float u, float v, uint32_t seed, float* rgb) {
   lerp_rgb(dark, ground, std::clamp((best - 0.85f) * 6.f, 0.f, 1.f), rgb);
 }
 
+// Pebbles: one rounded stone per cell of a periodic, jittered 6x6 lattice (Voronoi cells),
+// each with its own tint, lit from the upper left, set in dark gaps: many small, distinct,
+// crisp shapes, which plain L2 solid synthesis smooths into flat blobs (issue 12).
+void pebbles(float u, float v, uint32_t seed, float* rgb) {
+  const int cells = 6;
+  float d1 = 1e9f, d2 = 1e9f, ox = 0.f, oy = 0.f;
+  uint32_t h1 = 0;
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx) {
+      const int cx = int(std::floor(u * cells)) + dx, cy = int(std::floor(v * cells)) + dy;
+      const uint32_t h = hash3(uint32_t(((cx % cells) + cells) % cells), uint32_t(((cy % cells) + cells) % cells), seed);
+      const float px = (cx + 0.15f + 0.7f * unit(h)) / cells, py = (cy + 0.15f + 0.7f * unit(h * 2654435761u)) / cells;
+      const float d = std::hypot(u - px, v - py) * cells;
+      if (d < d1) {
+        d2 = d1;
+        d1 = d;
+        h1 = h;
+        ox = (u - px) * cells;
+        oy = (v - py) * cells;
+      } else if (d < d2) {
+        d2 = d;
+      }
+    }
+  const float grit = fbm(u, v, 16, 16, seed + 13) - 0.5f;
+  const float gap[3] = {0.16f + 0.1f * grit, 0.13f + 0.08f * grit, 0.1f + 0.06f * grit};
+  const float tan[3] = {0.78f, 0.58f, 0.38f}, grey[3] = {0.62f, 0.6f, 0.57f};
+  float stone[3];
+  lerp_rgb(tan, grey, unit(h1 ^ 0x27d4eb2fu), stone);
+  const float brightness = 0.75f + 0.35f * unit(h1 ^ 0x165667b1u);
+  const float light = std::clamp(1.f - 0.9f * (ox + oy), 0.45f, 1.35f);
+  for (int c = 0; c < 3; ++c) stone[c] = std::clamp(stone[c] * brightness * light + 0.08f * grit, 0.f, 1.f);
+  lerp_rgb(gap, stone, std::clamp((d2 - d1 - 0.1f) * 10.f, 0.f, 1.f), rgb);
+}
+
 }  // namespace
 
-std::vector<std::string> procedural_kind_names() { return {"wood", "stripes", "bricks", "noise", "spots"}; }
+std::vector<std::string> procedural_kind_names() { return {"wood", "stripes", "bricks", "noise", "spots", "pebbles"}; }
 
 Result<ProceduralKind> parse_procedural_kind(const std::string& name) {
   if (name == "wood") return ProceduralKind::kWood;
@@ -121,7 +155,9 @@ Result<ProceduralKind> parse_procedural_kind(const std::string& name) {
   if (name == "bricks") return ProceduralKind::kBricks;
   if (name == "noise") return ProceduralKind::kNoise;
   if (name == "spots") return ProceduralKind::kSpots;
-  return Status(StatusCode::kInvalidArgument, "unknown kind '" + name + "' (wood, stripes, bricks, noise, spots)", "kind");
+  if (name == "pebbles") return ProceduralKind::kPebbles;
+  return Status(StatusCode::kInvalidArgument, "unknown kind '" + name + "' (wood, stripes, bricks, noise, spots, pebbles)",
+                "kind");
 }
 
 Result<ImageF> make_procedural_exemplar(const ProceduralParams& p) {
@@ -138,6 +174,7 @@ Result<ImageF> make_procedural_exemplar(const ProceduralParams& p) {
         case ProceduralKind::kBricks: bricks(u, v, p.seed, srgb); break;
         case ProceduralKind::kNoise: noise(u, v, p.seed, srgb); break;
         case ProceduralKind::kSpots: spots(u, v, p.seed, srgb); break;
+        case ProceduralKind::kPebbles: pebbles(u, v, p.seed, srgb); break;
       }
       float* out = img.at(x, y);
       for (int c = 0; c < 3; ++c) out[c] = srgb_to_linear(std::clamp(srgb[c], 0.f, 1.f));

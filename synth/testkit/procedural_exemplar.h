@@ -10,7 +10,7 @@
 
 namespace solidtex {
 
-enum class ProceduralKind { kWood, kStripes, kBricks, kNoise, kSpots };
+enum class ProceduralKind { kWood, kStripes, kBricks, kNoise, kSpots, kPebbles };
 
 struct ProceduralParams {
   ProceduralKind kind = ProceduralKind::kWood;

@@ -147,4 +147,36 @@ double sharpness_ratio(const ImageF& cut, const ImageF& exemplar) {
   return e > 0 ? mean_gradient(cut, false) / e : 0.0;
 }
 
+ImageF toroidal_crop(const ImageF& img, int x0, int y0, int w, int h) {
+  ImageF out(w, h, img.channels);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < img.channels; ++c) out.at(x, y)[c] = img.wrapped(x0 + x, y0 + y)[c];
+  return out;
+}
+
+ImageF gaussian_blur(const ImageF& img, double sigma) {
+  const int r = int(std::ceil(3 * sigma));
+  std::vector<float> k(size_t(2 * r + 1));
+  float total = 0;
+  for (int i = -r; i <= r; ++i) total += k[size_t(i + r)] = float(std::exp(-0.5 * i * i / (sigma * sigma)));
+  for (float& v : k) v /= total;
+  ImageF tmp(img.width, img.height, img.channels), out(img.width, img.height, img.channels);
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x)
+      for (int c = 0; c < img.channels; ++c) {
+        float s = 0;
+        for (int i = -r; i <= r; ++i) s += k[size_t(i + r)] * img.wrapped(x + i, y)[c];
+        tmp.at(x, y)[c] = s;
+      }
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x)
+      for (int c = 0; c < img.channels; ++c) {
+        float s = 0;
+        for (int i = -r; i <= r; ++i) s += k[size_t(i + r)] * tmp.wrapped(x, y + i)[c];
+        out.at(x, y)[c] = s;
+      }
+  return out;
+}
+
 }  // namespace solidtex

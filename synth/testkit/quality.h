@@ -29,4 +29,9 @@ double coverage(const ImageF& cut, const ImageF& exemplar, int n, int stride = 1
 // `exemplar` (toroidal): about 1 when the cut is as crisp as the exemplar, well below when blurred.
 double sharpness_ratio(const ImageF& cut, const ImageF& exemplar);
 
+// Test and benchmark references: a w x h window of `img` at (x0, y0), wrapping around its
+// edges, and a separable Gaussian blur (toroidal, sigma in pixels).
+ImageF toroidal_crop(const ImageF& img, int x0, int y0, int w, int h);
+ImageF gaussian_blur(const ImageF& img, double sigma);
+
 }  // namespace solidtex

@@ -4,49 +4,14 @@
 
 #include <gtest/gtest.h>
 
-#include <cmath>
-
 #include "testkit/test_support.h"
 
 namespace solidtex {
 namespace {
 
-ImageF crop(const ImageF& img, int x0, int y0, int w, int h) {
-  ImageF out(w, h, img.channels);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x)
-      for (int c = 0; c < img.channels; ++c) out.at(x, y)[c] = img.wrapped(x0 + x, y0 + y)[c];
-  return out;
-}
-
-// Separable Gaussian, toroidal, sigma in pixels.
-ImageF blurred(const ImageF& img, double sigma) {
-  const int r = int(std::ceil(3 * sigma));
-  std::vector<float> k(size_t(2 * r + 1));
-  float total = 0;
-  for (int i = -r; i <= r; ++i) total += k[size_t(i + r)] = float(std::exp(-0.5 * i * i / (sigma * sigma)));
-  for (float& v : k) v /= total;
-  ImageF tmp(img.width, img.height, img.channels), out(img.width, img.height, img.channels);
-  for (int y = 0; y < img.height; ++y)
-    for (int x = 0; x < img.width; ++x)
-      for (int c = 0; c < img.channels; ++c) {
-        float s = 0;
-        for (int i = -r; i <= r; ++i) s += k[size_t(i + r)] * img.wrapped(x + i, y)[c];
-        tmp.at(x, y)[c] = s;
-      }
-  for (int y = 0; y < img.height; ++y)
-    for (int x = 0; x < img.width; ++x)
-      for (int c = 0; c < img.channels; ++c) {
-        float s = 0;
-        for (int i = -r; i <= r; ++i) s += k[size_t(i + r)] * tmp.wrapped(x, y + i)[c];
-        out.at(x, y)[c] = s;
-      }
-  return out;
-}
-
 TEST(Quality, ACropOfTheExemplarIsAsSharpAndCoversIt) {
   const ImageF ex = testing::procedural(ProceduralKind::kSpots, 48, 48);
-  const ImageF cut = crop(ex, 7, 11, 48, 48);  // the whole exemplar, shifted (toroidal)
+  const ImageF cut = toroidal_crop(ex, 7, 11, 48, 48);  // the whole exemplar, shifted (toroidal)
   EXPECT_NEAR(sharpness_ratio(cut, ex), 1.0, 0.1);
   // Not zero: the exemplar's neighborhoods across its wrap-around seam fall outside the cut.
   EXPECT_LT(coverage(cut, ex, 5, 2), 1e-3);
@@ -54,8 +19,8 @@ TEST(Quality, ACropOfTheExemplarIsAsSharpAndCoversIt) {
 
 TEST(Quality, BlurIsSeenByCoverageAndSharpnessButRewardedByEnergy) {
   const ImageF ex = testing::procedural(ProceduralKind::kSpots, 48, 48);
-  const ImageF sharp = crop(ex, 7, 11, 48, 48);
-  const ImageF blur = blurred(sharp, 2.0);
+  const ImageF sharp = toroidal_crop(ex, 7, 11, 48, 48);
+  const ImageF blur = gaussian_blur(sharp, 2.0);
   EXPECT_LT(sharpness_ratio(blur, ex), 0.6);
   EXPECT_GT(coverage(blur, ex, 5, 2), 4 * coverage(sharp, ex, 5, 2));
   // The reason for the two-sided measures: a flat image (the exemplar's mean everywhere) shows
