@@ -170,6 +170,12 @@ TEST(ApiJson, SynthesisParamsMatchTheVolumeSchema) {
       EXPECT_TRUE(synthesis_error({{key, {lo, hi, hi}}}).is_ok()) << key;
       EXPECT_EQ(synthesis_error({{key, {lo, hi + 0.5, hi}}}).field(), "params." + key);
       EXPECT_EQ(synthesis_error({{key, {lo - 0.5, hi, hi}}}).field(), "params." + key);
+    } else if (prop["type"] == "number") {
+      const double lo = prop["minimum"], hi = prop["maximum"];
+      EXPECT_TRUE(synthesis_error({{key, lo}}).is_ok()) << key << " = " << lo;
+      EXPECT_TRUE(synthesis_error({{key, hi}}).is_ok()) << key << " = " << hi;
+      EXPECT_EQ(synthesis_error({{key, lo - 0.5}}).field(), "params." + key);
+      EXPECT_EQ(synthesis_error({{key, hi + 0.5}}).field(), "params." + key);
     } else {
       ADD_FAILURE() << "untested schema property " << key;
     }
