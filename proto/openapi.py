@@ -144,7 +144,7 @@ S = {
      "exemplars": {"type": "array", "items": {"type": "string"}}, "label": {"type": "string"},
      "field": {"type": "object", "description": "Where the field came from: {\"kind\": \"identity\"}, {\"kind\": \"spec\", \"spec\"} or {\"kind\": \"stored\", \"id\", \"revision\"} (the volume keeps its own copy of that revision).", "properties": {"kind": {"type": "string", "enum": ["identity", "spec", "stored"]}, "spec": {"type": "string"}, "id": {"type": "string"}, "revision": {"type": "integer"}}},
      "field_description": {"type": "string", "description": "Human-readable description of the field, e.g. 'identity' or 'quat:0.92,0,0,0.38'."},
-     "seed": {"type": "integer"}, "params": {"type": "object"}}},
+     "seed": {"type": "integer"}, "params": {"type": "object", "description": "The synthesis params as given, with `typicality` pinned to the default it was created with (0 for volumes stored before it existed), so later defaults never change a stored volume."}}},
  "Cut": {"type": "object", "additionalProperties": False, "required": ["origin", "u", "v", "size"],
      "description": f"The far corner origin + W*u + H*v must lie within +-2^28 too (else 400); W*H at most --max-voxels (else 422).",
      "properties": {

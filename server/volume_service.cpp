@@ -455,12 +455,34 @@ VolumeService::VolumeService(DataStore& store, const ServerConfig& config, Exemp
     : impl_(std::make_unique<Impl>(store, config, exemplars, fields, meshes)) {}
 VolumeService::~VolumeService() = default;
 
+namespace {
+
+// Appearance-changing defaults are written into a volume's stored spec, so that a later release
+// changing them never changes a stored volume's voxels: writes `value` as the params'
+// typicality when they give none and returns whether it did. A spec that is not an object, or
+// whose params are not, is left for parse_spec to refuse.
+bool pin_typicality(json& spec, double value) {
+  if (!spec.is_object()) return false;
+  json& params = spec["params"];
+  if (params.is_null()) params = json::object();
+  if (!params.is_object() || params.contains("typicality")) return false;
+  params["typicality"] = value;
+  return true;
+}
+
+}  // namespace
+
 Status VolumeService::start(std::vector<std::string>* report) {
   for (const std::string& id : impl_->store.ids(ResourceKind::kVolume)) {
     auto load = [&]() -> Result<std::shared_ptr<Volume>> {
       SOLIDTEX_ASSIGN_OR_RETURN(std::string text, impl_->store.read_text(ResourceKind::kVolume, id, "volume.json"));
       SOLIDTEX_ASSIGN_OR_RETURN(json info, parse_json_text(text, "volume.json"));
       json spec = info["spec"];
+      // Volumes stored before the typicality penalty existed were synthesized without it.
+      if (pin_typicality(spec, 0.0)) {
+        info["spec"] = spec;
+        info["params"]["typicality"] = 0.0;
+      }
       json desc;
       SOLIDTEX_ASSIGN_OR_RETURN(auto v, impl_->parse_spec(spec, nullptr, &desc));
       if (info["field"].value("kind", "") == "stored") {  // checked now, loaded at the first query
@@ -488,6 +510,7 @@ Status VolumeService::start(std::vector<std::string>* report) {
 Result<json> VolumeService::create(const std::string& spec_text) {
   SOLIDTEX_ASSIGN_OR_RETURN(json spec, parse_json_text(spec_text, "body"));
   if (spec.contains("id")) return Status(StatusCode::kInvalidArgument, "unknown key", "id");
+  pin_typicality(spec, SynthesisParams{}.typicality);
   std::vector<uint8_t> field_bytes;
   json field_desc;
   SOLIDTEX_ASSIGN_OR_RETURN(auto v, impl_->parse_spec(spec, &field_bytes, &field_desc));

@@ -1,4 +1,5 @@
 """Persistence: everything acknowledged survives kill -9 and SIGTERM; leftovers are ignored."""
+import json
 import os
 import time
 
@@ -87,3 +88,26 @@ def test_sigterm_exits_cleanly_and_restarts(server, exemplars):
     b = server(data_dir=a.data_dir)
     assert b.client.get_exemplar(ex["id"])["state"] == "ready"
     assert np.array_equal(b.client.slice(vol["id"], "z", 1, (16, 16)), before)
+
+
+def test_volumes_stored_before_typicality_keep_their_voxels(server, exemplars):
+    """New volumes pin the typicality default they were made with; a volume.json written before
+    the penalty existed (no typicality anywhere) comes back with typicality 0, the matching its
+    voxels were synthesized with, so no release changes a stored volume's look."""
+    a = server()
+    c = a.client
+    ex = upload_ready(c, exemplars["spots"])
+    vol = c.create_volume(exemplar=ex["id"], seed=4)
+    assert vol["params"] == {"typicality": 0.5}, vol
+    plain = c.create_volume(exemplar=ex["id"], seed=4, params={"typicality": 0})
+    want = c.slice(plain["id"], "z", 2, (24, 24))
+    assert not np.array_equal(c.slice(vol["id"], "z", 2, (24, 24)), want), "typicality changed nothing"
+    assert a.stop(grace=10) == 0
+    path = next(p for p in a.data_dir.rglob("volume.json") if vol["id"] in str(p))
+    info = json.loads(path.read_text())
+    del info["params"]["typicality"], info["spec"]["params"]["typicality"]
+    path.write_text(json.dumps(info))
+    b = server(data_dir=a.data_dir)
+    got = b.client.get_volume(vol["id"])
+    assert got["params"]["typicality"] == 0, got
+    assert np.array_equal(b.client.slice(vol["id"], "z", 2, (24, 24)), want)
