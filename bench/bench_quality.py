@@ -87,6 +87,7 @@ def main() -> int:
     out_dir.mkdir(parents=True, exist_ok=True)
     embark = None if args.no_embark else embark_binary(build)
     n = args.size
+    tuning = [] if args.typicality is None else ["--typicality", args.typicality]
     results = []
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
@@ -103,7 +104,6 @@ def main() -> int:
                 image = out_dir / f"{name}_{cut}.png"
                 stats = tmp / f"{name}_{cut}.json"
                 t0 = time.monotonic()
-                tuning = [] if args.typicality is None else ["--typicality", args.typicality]
                 run([solidtex, "slice", table, *where, "--size", f"{n},{n}", *tuning, "-o", image, "--stats", stats])
                 seconds = time.monotonic() - t0
                 scores = texmetric(python, image, ex)

@@ -85,10 +85,8 @@ Status run_slice(const std::vector<std::string>& argv) {
     SOLIDTEX_ASSIGN_OR_RETURN(auto w, args.get_list("--plane-weights", 3));
     params.plane_weights = {float(w[0]), float(w[1]), float(w[2])};
   }
-  if (args.has("--typicality")) {
-    SOLIDTEX_ASSIGN_OR_RETURN(auto t, args.get_list("--typicality", 1));
-    params.typicality = float(t[0]);
-  }
+  SOLIDTEX_ASSIGN_OR_RETURN(double typicality, args.get_double("--typicality", params.typicality, 0, 4));
+  params.typicality = float(typicality);
   SOLIDTEX_RETURN_IF_ERROR(params.validate());
   SOLIDTEX_ASSIGN_OR_RETURN(int threads, args.get_int("--threads", 0, 0, 1024));
   set_thread_limit(threads);

@@ -481,7 +481,7 @@ Status VolumeService::start(std::vector<std::string>* report) {
       // Volumes stored before the typicality penalty existed were synthesized without it.
       if (pin_typicality(spec, 0.0)) {
         info["spec"] = spec;
-        info["params"]["typicality"] = 0.0;
+        info["params"] = spec["params"];
       }
       json desc;
       SOLIDTEX_ASSIGN_OR_RETURN(auto v, impl_->parse_spec(spec, nullptr, &desc));

@@ -28,7 +28,7 @@ std::vector<float> typicality_penalty(const std::vector<float>& projected, int d
   mean_var /= double(d);
   std::vector<double> weight(d, 0.0);
   // A coefficient with no spread over the image says nothing about typicality.
-  for (size_t r = 0; r < d; ++r) weight[r] = var[r] > 1e-12 * mean_var && var[r] > 0 ? std::sqrt(mean_var / var[r]) : 0.0;
+  for (size_t r = 0; r < d; ++r) weight[r] = var[r] > 1e-12 * mean_var ? std::sqrt(mean_var / var[r]) : 0.0;
   std::vector<double> e(pixels, 0.0);
   double largest = 0;
   for (size_t p = 0; p < pixels; ++p) {

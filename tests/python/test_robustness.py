@@ -54,6 +54,19 @@ def test_inline_identity_field_spec_makes_a_working_volume(srv):
     alive(srv)
 
 
+def test_typicality_at_its_documented_extremes(srv):
+    # [0, 4] both synthesize; anything outside, or not a number, is a 400 naming the field
+    for value in (0, 4):
+        r = create_volume(srv, params={"typicality": value})
+        assert r.status_code == 201, r.text
+        assert r.json()["params"]["typicality"] == value
+        got = slice_of(srv, r.json()["id"])
+        assert got.status_code == 200, got.text
+    for value in (-0.001, 4.001, 1e308, "0.5", None, [0.5]):
+        assert_error(create_volume(srv, params={"typicality": value}), 400, "invalid_argument", "params.typicality")
+    alive(srv)
+
+
 @pytest.mark.parametrize("spec", ["identity;scale:2.1,1,1", "axis:0,0,1,30;scale:3,1,1"])
 def test_stretched_fields_synthesize_instead_of_crashing(srv, spec):
     r = create_volume(srv, field={"spec": spec})
