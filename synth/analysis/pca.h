@@ -21,11 +21,14 @@ struct PcaBasis {
 // out[r] = sum over i ascending of basis_r[i] * (in[i] - mean[i]). The basis is kept
 // transposed (input-major) so each input feeds output_dims independent accumulators, which
 // vectorise; the order per output is fixed, so every build and clone gives the same bits.
+// Rows are zero-padded to `stride` (a multiple of 8, at most 64) so the accumulators are a
+// compile-time block that stays in registers.
 struct PcaProjection {
   int input_dims = 0;
   int output_dims = 0;
+  int stride = 0;              // output_dims rounded up to a multiple of 8
   std::vector<float> mean;     // input_dims
-  std::vector<float> basis_t;  // input_dims rows of output_dims
+  std::vector<float> basis_t;  // input_dims rows of `stride` (columns past output_dims are 0)
 
   static PcaProjection of(const PcaBasis& b);
   void project(const float* in, float* out) const;

@@ -107,8 +107,12 @@ CorrectionContext CorrectionContext::make(const Table& table, PyramidLevel l, co
 
 namespace detail {
 
-// Squared distance with four fixed accumulator lanes: vectorisable and order-stable.
-__attribute__((target_clones("avx2", "default"))) float plane_distance(const float* q, const float* a, int d) {
+namespace {
+
+// Squared distance with four fixed accumulator lanes, lane j summing dims j, j+4, ... in
+// ascending order, then (lane0 + lane1) + (lane2 + lane3): the same bits at every vector
+// width. Inlined into the candidate loop, where it is called hundreds of times per voxel.
+inline float plane_distance(const float* q, const float* a, int d) {
   float acc[4] = {0.f, 0.f, 0.f, 0.f};
   int r = 0;
   for (; r + 4 <= d; r += 4)
@@ -123,6 +127,29 @@ __attribute__((target_clones("avx2", "default"))) float plane_distance(const flo
   return (acc[0] + acc[1]) + (acc[2] + acc[3]);
 }
 
+// Plane k's weighted cost term of one exemplar pixel (by flat index) for the current query.
+struct PlaneTerm {
+  const float* query;
+  const PlaneAppearance* app;
+  float weight;
+  float typicality;
+  int dims;
+  float operator()(size_t pixel) const {
+    float dk = plane_distance(query, &app->projected[pixel * size_t(dims)], dims);
+    if (typicality > 0.f) dk += typicality * app->typicality[pixel];
+    return weight * dk;
+  }
+  void prefetch(size_t pixel) const {
+    const char* row = reinterpret_cast<const char*>(&app->projected[pixel * size_t(dims)]);
+    __builtin_prefetch(row);
+    __builtin_prefetch(row + size_t(dims) * sizeof(float) - 1);
+  }
+};
+
+size_t pixel_index(const PlaneAppearance& app, ExemplarPixel p) { return size_t(p.y) * app.stack.width + size_t(p.x); }
+
+}  // namespace
+
 void project_planes(const CorrectionContext& ctx, CorrectionScratch& s) {
   const int in_dims = ctx.n * ctx.n * ctx.channels;
   const int d = ctx.dims;
@@ -131,50 +158,89 @@ void project_planes(const CorrectionContext& ctx, CorrectionScratch& s) {
     ctx.projection[size_t(k)].project(s.gathered.data() + size_t(k) * in_dims, s.projected.data() + size_t(k) * d);
 }
 
+// The winner is the minimum of (cost, triple) over the candidate set, so the order in which
+// candidates are visited cannot change it; only the cost of each survivor must be exact.
+// A candidate's cost is ((t0 + t1) + t2) in floats, t_k = w_k * (distance_k + typicality *
+// penalty_k) >= 0, and float addition of non-negative terms is monotone, so any partial sum
+// is a lower bound of the cost: a candidate (or a whole source list) whose lower bound
+// exceeds the best cost so far is skipped without changing the result. Every candidate of
+// plane k's source list at pixel p has T[k] = p, so t_k is computed once per source, and
+// sources are visited cheapest first so the bound tightens early.
 CoordinateTriple best_candidate(const CorrectionContext& ctx, const CoordinateTriple& current,
                                 const std::array<std::array<ExemplarPixel, 9>, 3>& sources, CorrectionScratch& s) {
-  // Candidates of distinct sources of one plane differ in that plane's coordinate, and one
-  // source's list holds distinct triples, so deduplicating the (at most 9) sources per plane
-  // leaves only cross-plane repeats, which cost a re-evaluation but cannot change the winner.
   const TableLevel& level = *ctx.level;
-  const int d = ctx.dims;
+  std::array<PlaneTerm, 3> term;
+  for (int k = 0; k < 3; ++k)
+    term[size_t(k)] = {s.projected.data() + size_t(k) * ctx.dims, level.planes[size_t(k)].get(), ctx.cost_weights[size_t(k)],
+                       ctx.typicality, ctx.dims};
   float best = std::numeric_limits<float>::infinity();
   CoordinateTriple best_t{};
-  auto consider = [&](const CoordinateTriple& t) {
-    // Planes are summed in a fixed order; a candidate whose partial cost already exceeds the
-    // best cannot win (costs only grow), so stopping early changes no result.
-    float cost = 0.f;
-    for (int k = 0; k < 3 && cost <= best; ++k) {
-      const PlaneAppearance& app = *level.planes[size_t(k)];
-      const size_t pixel = size_t(t.at[size_t(k)].y) * app.stack.width + size_t(t.at[size_t(k)].x);
-      float dk = plane_distance(s.projected.data() + size_t(k) * d, &app.projected[pixel * d], d);
-      if (ctx.typicality > 0.f) dk += ctx.typicality * app.typicality[pixel];
-      cost += ctx.cost_weights[size_t(k)] * dk;
-    }
+  auto offer = [&](float cost, const CoordinateTriple& t) {
     if (cost < best || (cost == best && t < best_t)) {
       best = cost;
       best_t = t;
     }
   };
+
   CoordinateTriple cur = current;
+  std::array<float, 3> cur_terms;
   for (int k = 0; k < 3; ++k) {
-    const ImageF& img = level.planes[size_t(k)]->stack;
-    cur.at[size_t(k)] = {ImageF::wrap(cur.at[size_t(k)].x, img.width), ImageF::wrap(cur.at[size_t(k)].y, img.height)};
+    const PlaneAppearance& app = *level.planes[size_t(k)];
+    cur.at[size_t(k)] = {ImageF::wrap(cur.at[size_t(k)].x, app.stack.width), ImageF::wrap(cur.at[size_t(k)].y, app.stack.height)};
+    cur_terms[size_t(k)] = term[size_t(k)](pixel_index(app, cur.at[size_t(k)]));
   }
-  consider(cur);
+  offer((cur_terms[0] + cur_terms[1]) + cur_terms[2], cur);
+
+  struct Source {
+    float own;  // t_k of the source pixel
+    int plane;
+    ExemplarPixel pixel;
+  };
+  std::array<Source, 27> list;
+  int count = 0;
   for (int k = 0; k < 3; ++k) {
     const PlaneCandidates& pc = level.candidates.planes[size_t(k)];
-    std::array<ExemplarPixel, 9> unique;
-    int count = 0;
+    const int first = count;
     for (const ExemplarPixel& raw : sources[size_t(k)]) {
       const ExemplarPixel src{ImageF::wrap(raw.x, pc.width), ImageF::wrap(raw.y, pc.height)};
       bool seen = false;
-      for (int u = 0; u < count && !seen; ++u) seen = unique[size_t(u)] == src;
+      for (int u = first; u < count && !seen; ++u) seen = list[size_t(u)].pixel == src;
       if (seen) continue;
-      unique[size_t(count++)] = src;
-      const auto list = pc.at(src);
-      const size_t take = std::min(list.size(), size_t(ctx.candidates_per_source));
-      for (size_t c = 0; c < take; ++c) consider(list[c]);
+      list[size_t(count++)] = {0.f, k, src};
+      // The lists and rows lie far apart in tables of megabytes: ask for them all up front.
+      const auto cands = pc.at(src);
+      const char* bytes = reinterpret_cast<const char*>(cands.data());
+      for (size_t off = 0; off < cands.size_bytes(); off += 64) __builtin_prefetch(bytes + off);
+      term[size_t(k)].prefetch(pixel_index(*level.planes[size_t(k)], src));
+    }
+  }
+  for (int i = 0; i < count; ++i) {
+    Source& src = list[size_t(i)];
+    src.own = term[size_t(src.plane)](pixel_index(*level.planes[size_t(src.plane)], src.pixel));
+  }
+  std::sort(list.begin(), list.begin() + count, [](const Source& a, const Source& b) { return a.own < b.own; });
+
+  for (int i = 0; i < count; ++i) {
+    const Source& src = list[size_t(i)];
+    if (src.own > best) break;  // every later source costs at least as much
+    const int k = src.plane;
+    const int j1 = k == 0 ? 1 : 0, j2 = k == 2 ? 1 : 2;  // the other planes, ascending
+    const PlaneAppearance& a1 = *level.planes[size_t(j1)];
+    const PlaneAppearance& a2 = *level.planes[size_t(j2)];
+    const auto cands = level.candidates.planes[size_t(k)].at(src.pixel);
+    const size_t take = std::min(cands.size(), size_t(ctx.candidates_per_source));
+    for (size_t c = 0; c < take; ++c) {
+      term[size_t(j1)].prefetch(pixel_index(a1, cands[c].at[size_t(j1)]));
+      term[size_t(j2)].prefetch(pixel_index(a2, cands[c].at[size_t(j2)]));
+    }
+    for (size_t c = 0; c < take; ++c) {
+      const CoordinateTriple& t = cands[c];
+      std::array<float, 3> tk;
+      tk[size_t(k)] = t.at[size_t(k)] == src.pixel ? src.own : term[size_t(k)](pixel_index(*level.planes[size_t(k)], t.at[size_t(k)]));
+      tk[size_t(j1)] = term[size_t(j1)](pixel_index(a1, t.at[size_t(j1)]));
+      if (tk[size_t(k)] + tk[size_t(j1)] > best) continue;
+      tk[size_t(j2)] = term[size_t(j2)](pixel_index(a2, t.at[size_t(j2)]));
+      offer((tk[0] + tk[1]) + tk[2], t);
     }
   }
   return best_t;

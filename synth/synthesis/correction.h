@@ -93,23 +93,36 @@ CoordinateTriple best_candidate(const CorrectionContext& ctx, const CoordinateTr
                                 const std::array<std::array<ExemplarPixel, 9>, 3>& sources, CorrectionScratch& s);
 }  // namespace detail
 
+namespace detail {
+// The 3 * N * N samples of the stencil, C channels each, sample after sample. C is a
+// compile-time constant so the per-sample accumulate and store stay in registers.
+template <int C, class Reader>
+inline void gather_samples(const ReadStencil& st, Reader& read, float* g) {
+  const int samples = 3 * st.n * st.n;
+  for (int q = 0; q < samples; ++q) {
+    float acc[C] = {};
+    for (int t = st.begin[size_t(q)]; t < st.begin[size_t(q) + 1]; ++t) {
+      const Tap& tap = st.taps[size_t(t)];
+      const VoxelState& v = read(tap.dx, tap.dy, tap.dz);
+      for (int k = 0; k < C; ++k) acc[k] += tap.weight * v.color[size_t(k)];
+    }
+    for (int k = 0; k < C; ++k) g[k] = acc[k];
+    g += C;
+  }
+}
+}  // namespace detail
+
 // Corrects one voxel. `read(dx, dy, dz)` returns the neighbour's state at the version the
 // history window names for that offset.
 template <class Reader>
 CoordinateTriple correct_voxel(const CorrectionContext& ctx, const ReadStencil& st, Reader& read, CorrectionScratch& s) {
-  const int c = ctx.channels;
-  const int nn = ctx.n * ctx.n;
-  s.gathered.resize(size_t(3) * nn * c);
+  s.gathered.resize(size_t(3) * ctx.n * ctx.n * ctx.channels);
   float* g = s.gathered.data();
-  const int samples = 3 * nn;
-  for (int q = 0; q < samples; ++q) {
-    float acc[4] = {0, 0, 0, 0};
-    for (int t = st.begin[q]; t < st.begin[q + 1]; ++t) {
-      const Tap& tap = st.taps[size_t(t)];
-      const VoxelState& v = read(tap.dx, tap.dy, tap.dz);
-      for (int k = 0; k < c; ++k) acc[k] += tap.weight * v.color[size_t(k)];
-    }
-    for (int k = 0; k < c; ++k) *g++ = acc[k];
+  switch (ctx.channels) {
+    case 1: detail::gather_samples<1>(st, read, g); break;
+    case 2: detail::gather_samples<2>(st, read, g); break;
+    case 3: detail::gather_samples<3>(st, read, g); break;
+    default: detail::gather_samples<4>(st, read, g); break;
   }
   detail::project_planes(ctx, s);
   const CoordinateTriple current = read(0, 0, 0).triple;

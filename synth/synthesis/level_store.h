@@ -53,7 +53,7 @@ class LevelStore {
     const VoxelState* find(int dx, int dy, int dz, int slot) const {
       const int lx = (p_.x & 7) + dx, ly = (p_.y & 7) + dy, lz = (p_.z & 7) + dz;
       const Brick* b = near_[size_t(((lz >> 3) + 1) * 9 + ((ly >> 3) + 1) * 3 + ((lx >> 3) + 1))];
-      return b ? &b->states[size_t((lx & 7) + 8 * (ly & 7) + 64 * (lz & 7)) * slots_ + slot] : nullptr;
+      return b ? &b->states[size_t(slot) * 512 + size_t((lx & 7) + 8 * (ly & 7) + 64 * (lz & 7))] : nullptr;
     }
 
    private:
@@ -66,10 +66,11 @@ class LevelStore {
 
  private:
   struct Brick {
-    std::vector<VoxelState> states;  // 512 * slots
+    std::vector<VoxelState> states;  // slots * 512, slot-major
     std::unique_ptr<std::atomic<uint8_t>[]> flags;
   };
-  size_t index(const Voxel& p, int slot) const { return size_t(BrickIndex::voxel_in_brick(p)) * slots_ + slot; }
+  // Slot-major: the voxels a correction reads (one slot, neighbouring positions) share cache lines.
+  size_t index(const Voxel& p, int slot) const { return size_t(slot) * 512 + size_t(BrickIndex::voxel_in_brick(p)); }
   Brick* brick(const Voxel& p) const { return table_[index_.brick_of(p)]; }
   int64_t brick_bytes() const { return 512 * slots_ * int64_t(sizeof(VoxelState) + 1); }
 
