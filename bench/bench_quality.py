@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import shlex
 import subprocess
 import sys
 import tempfile
@@ -71,6 +72,7 @@ def main() -> int:
     ap.add_argument("--out", type=Path, default=None)
     ap.add_argument("--no-embark", action="store_true")
     ap.add_argument("--typicality", type=float, default=None)
+    ap.add_argument("--slice-args", default="", help="extra `solidtex slice` flags, e.g. \"--passes 1\"")
     args = ap.parse_args()
     build = args.build.resolve()
     solidtex = build / "bin" / "solidtex"
@@ -87,7 +89,7 @@ def main() -> int:
     out_dir.mkdir(parents=True, exist_ok=True)
     embark = None if args.no_embark else embark_binary(build)
     n = args.size
-    tuning = [] if args.typicality is None else ["--typicality", args.typicality]
+    tuning = ([] if args.typicality is None else ["--typicality", args.typicality]) + shlex.split(args.slice_args)
     results = []
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
@@ -132,7 +134,7 @@ def main() -> int:
     if ratios:
         summary.update({"median_worst_swd_over_embark": float(np.median(ratios)),
                         "max_worst_swd_over_embark": float(np.max(ratios))})
-    print(json.dumps({"size": n, "typicality": args.typicality, "montages": str(out_dir), "exemplars": results, "summary": summary}, indent=1))
+    print(json.dumps({"size": n, "typicality": args.typicality, "slice_args": args.slice_args, "montages": str(out_dir), "exemplars": results, "summary": summary}, indent=1))
     return 0
 
 

@@ -40,6 +40,29 @@ HistoryWindow::Resolved HistoryWindow::resolve(const Voxel& p) const {
   return r;
 }
 
+NeighbourSlots::NeighbourSlots(const LevelSchedule& schedule, const HistoryWindow::Resolved& window, const Voxel& p) {
+  const int s = schedule.subpass_size();
+  const int centre[3] = {p.x, p.y, p.z};
+  for (int a = 0; a < 3; ++a)
+    for (int o = -kReach; o <= kReach; ++o) {
+      const int c = centre[a] + o;
+      uint8_t bits = s == 1 ? 0 : uint8_t((c & 1) << (4 + a));
+      for (int b = 0; b < window.count; ++b) {
+        const int lo[3] = {window.lo[size_t(b)].x, window.lo[size_t(b)].y, window.lo[size_t(b)].z};
+        const int hi[3] = {window.hi[size_t(b)].x, window.hi[size_t(b)].y, window.hi[size_t(b)].z};
+        if (c < lo[a] || c >= hi[a]) bits |= uint8_t(1 << b);
+      }
+      axis_[size_t(a)][size_t(o + kReach)] = bits;
+    }
+  for (int m = 0; m < 128; ++m) {
+    if (s == 1 && m >= 16) break;  // one update class: the parity bits are never set
+    int v = window.latest;
+    for (int b = 0; b < window.count; ++b)
+      if (m & (1 << b)) v = std::min(v, window.barrier_version[size_t(b)]);
+    slot_[size_t(m)] = schedule.slot_of_class(m >> 4, v);
+  }
+}
+
 std::vector<int> HistoryWindow::materialize(const Voxel& p, int d) const {
   std::vector<int> out;
   out.reserve(size_t(d) * d * d);

@@ -110,6 +110,8 @@ class LevelSchedule {
   int slot(const Voxel& p, int version) const {
     return slot_table_[size_t(UpdateClass::class_of(p, s_) * (final_version() + 1) + version)];
   }
+  // slot(p, version) for any p of update class `cls` (UpdateClass::class_of(p, subpass_size())).
+  int slot_of_class(int cls, int version) const { return slot_table_[size_t(cls * (final_version() + 1) + version)]; }
   int slot_count() const { return slot_count_; }  // max updates of any voxel + 1
   int subpass_size() const { return s_; }
 
@@ -118,6 +120,25 @@ class LevelSchedule {
   int s_ = 1;
   int slot_count_ = 1;
   std::vector<int> slot_table_;  // [class * (final_version + 1) + version]
+};
+
+// The storage slot of every neighbour p + o of one voxel p, |o| <= kReach on each axis, for
+// one step: slot(o) == schedule.slot(p + o, window.version_of(p + o)). Being outside a
+// barrier's cell and the update class both decide axis by axis, so a lookup is three small
+// table reads or-ed together and one table read; built once per corrected voxel.
+class NeighbourSlots {
+ public:
+  static constexpr int kReach = 8;
+  NeighbourSlots(const LevelSchedule& schedule, const HistoryWindow::Resolved& window, const Voxel& p);
+  int slot(int dx, int dy, int dz) const {
+    return slot_[size_t(axis_[0][size_t(dx + kReach)] | axis_[1][size_t(dy + kReach)] | axis_[2][size_t(dz + kReach)])];
+  }
+
+ private:
+  // Per axis and offset: bit b (0-3) when outside barrier b's cell on that axis, bit 4 + axis
+  // for the odd coordinate that makes up the update class.
+  std::array<std::array<uint8_t, 2 * kReach + 1>, 3> axis_{};
+  std::array<int, 128> slot_{};  // by (class << 4) | outside-barrier mask
 };
 
 }  // namespace solidtex

@@ -64,5 +64,38 @@ TEST(LevelSchedule, DualGridStepsSlotsAndBarriers) {
   EXPECT_EQ(LevelSchedule::make(2, p).final_version(), 2);
 }
 
+TEST(NeighbourSlots, EqualTheSchedulesSlotOfTheWindowsVersionForEveryOffset) {
+  int64_t checked = 0, distinct_slots = 0;
+  for (Scheme scheme : {Scheme::kPlain, Scheme::kSubpass, Scheme::kGrid, Scheme::kDualGrid}) {
+    SynthesisParams params;
+    params.scheme = scheme;
+    params.passes = 3;
+    params.cell_size = 6;  // small cells: the +-8 offsets cross several barriers
+    for (int level : {0, 2}) {
+      const LevelSchedule sch = LevelSchedule::make(level, params);
+      for (const Voxel p : {Voxel{0, 0, 0}, Voxel{5, -1, 7}, Voxel{-13, 22, 3}, Voxel{11, 6, -6}})
+        for (const CorrectionStep& step : sch.steps()) {
+          const HistoryWindow::Resolved w = step.window.resolve(p);
+          const NeighbourSlots slots(sch, w, p);
+          const int r = NeighbourSlots::kReach;
+          int first = -1;
+          for (int dz = -r; dz <= r; ++dz)
+            for (int dy = -r; dy <= r; ++dy)
+              for (int dx = -r; dx <= r; ++dx) {
+                const Voxel q{p.x + dx, p.y + dy, p.z + dz};
+                const int want = sch.slot(q, w.version_of(q));
+                ASSERT_EQ(slots.slot(dx, dy, dz), want) << scheme_name(scheme) << " level " << level << " step "
+                                                        << step.version << " offset " << dx << "," << dy << "," << dz;
+                if (first < 0) first = want;
+                distinct_slots += want != first;
+                ++checked;
+              }
+        }
+    }
+  }
+  EXPECT_GT(checked, 100000);
+  EXPECT_GT(distinct_slots, 0);  // the offsets do reach different slots
+}
+
 }  // namespace
 }  // namespace solidtex

@@ -188,7 +188,7 @@ Status correct_level(const LevelPass& pass, const LevelDependencies& dep, LevelS
   const int V = sch.final_version();
   const int L = pass.table.levels();
   // Stretched fields (scales > ~1.4 at N = 9) reach past the 27 bricks Neighborhood caches.
-  const bool near_reaches = frames.reach(l) <= LevelStore::Neighborhood::kReach;
+  const bool near_reaches = frames.reach(l) <= LevelStore::Neighborhood::kReach && frames.reach(l) <= NeighbourSlots::kReach;
   for (int v = 1; v <= V; ++v) {
     const int percent = int(100.0 * (l.index + double(v) / (V + 1)) / L);
     if (poller.poll(percent)) return Status(StatusCode::kCancelled, "synthesis cancelled");
@@ -206,9 +206,10 @@ Status correct_level(const LevelPass& pass, const LevelDependencies& dep, LevelS
         const ReadStencil& st = frames.stencil(l, p, local);
         const HistoryWindow::Resolved window = step.window.resolve(p);
         const LevelStore::Neighborhood near(store, p);
+        const NeighbourSlots slots(sch, window, p);
         auto read = [&](int dx, int dy, int dz) -> const VoxelState& {
           const Voxel q{p.x + dx, p.y + dy, p.z + dz};
-          const int slot = sch.slot(q, window.version_of(q));
+          const int slot = near_reaches ? slots.slot(dx, dy, dz) : sch.slot(q, window.version_of(q));
           if (!checks.read(store, q, slot)) return dummy_state();
           const VoxelState* s = near_reaches ? near.find(dx, dy, dz, slot) : store.find(q, slot);
           if (!s) {  // outside the sets: a dependency-analysis bug, never a wild read
