@@ -46,14 +46,6 @@ Quat operator*(const Quat& a, const Quat& b) {
           a.w * b.y - a.x * b.z + a.y * b.w + a.z * b.x, a.w * b.z + a.x * b.y - a.y * b.x + a.z * b.w};
 }
 
-void Rot3::apply(const float l[3], float w[3]) const {
-  for (int r = 0; r < 3; ++r) w[r] = m[r * 3 + 0] * l[0] + m[r * 3 + 1] * l[1] + m[r * 3 + 2] * l[2];
-}
-
-void Rot3::apply_inverse(const float w[3], float l[3]) const {
-  for (int r = 0; r < 3; ++r) l[r] = inv[r * 3 + 0] * w[0] + inv[r * 3 + 1] * w[1] + inv[r * 3 + 2] * w[2];
-}
-
 Rot3 Rot3::from_quat(const Quat& qin, const std::array<double, 3>& scale) {
   const Quat q = qin.normalized();
   const double w = q.w, x = q.x, y = q.y, z = q.z;

@@ -33,9 +33,15 @@ struct Rot3 {
   std::array<float, 9> m{1, 0, 0, 0, 1, 0, 0, 0, 1};
   std::array<float, 9> inv{1, 0, 0, 0, 1, 0, 0, 0, 1};
   // world = M * local
-  void apply(const float local[3], float world[3]) const;
+  // Inline: stencils apply it to every sample of every voxel in varying fields.
+  void apply(const float l[3], float w[3]) const {
+    for (int r = 0; r < 3; ++r) w[r] = m[size_t(r * 3 + 0)] * l[0] + m[size_t(r * 3 + 1)] * l[1] + m[size_t(r * 3 + 2)] * l[2];
+  }
   // local = M^-1 * world
-  void apply_inverse(const float world[3], float local[3]) const;
+  void apply_inverse(const float w[3], float l[3]) const {
+    for (int r = 0; r < 3; ++r)
+      l[r] = inv[size_t(r * 3 + 0)] * w[0] + inv[size_t(r * 3 + 1)] * w[1] + inv[size_t(r * 3 + 2)] * w[2];
+  }
   static Rot3 from_quat(const Quat& q, const std::array<double, 3>& scale = {1, 1, 1});
   friend bool operator==(const Rot3&, const Rot3&) = default;
 };

@@ -7,6 +7,16 @@
 
 namespace solidtex {
 namespace {
+// std::lround (half away from zero) for the small finite values of stencil offsets, inline:
+// the truncation and the remainder x - trunc(x) are exact in float.
+int round_offset(float x) {
+  int i = int(x);
+  const float rest = x - float(i);
+  if (rest >= 0.5f) ++i;
+  else if (rest <= -0.5f) --i;
+  return i;
+}
+
 void local_offset(int plane, int i, int j, float out[3]) {
   out[0] = out[1] = out[2] = 0.f;
   out[kPlaneFirstAxis[size_t(plane)]] = float(i);
@@ -28,7 +38,7 @@ void build_stencil(const Rot3& r, int n, bool trilinear, ReadStencil& out) {
         local_offset(plane, i, j, local);
         r.apply(local, w);
         if (!trilinear) {
-          out.taps.push_back({int8_t(std::lround(w[0])), int8_t(std::lround(w[1])), int8_t(std::lround(w[2])), 1.f});
+          out.taps.push_back({int8_t(round_offset(w[0])), int8_t(round_offset(w[1])), int8_t(round_offset(w[2])), 1.f});
           continue;
         }
         int f[3];
@@ -54,19 +64,59 @@ void build_stencil(const Rot3& r, int n, bool trilinear, ReadStencil& out) {
       float local[3], w[3];
       local_offset(plane, ab % 3 - 1, ab / 3 - 1, local);
       r.apply(local, w);
-      out.candidate[size_t(plane)][size_t(ab)] = {int8_t(std::lround(w[0])), int8_t(std::lround(w[1])),
-                                                  int8_t(std::lround(w[2]))};
+      out.candidate[size_t(plane)][size_t(ab)] = {int8_t(round_offset(w[0])), int8_t(round_offset(w[1])),
+                                                  int8_t(round_offset(w[2]))};
     }
 }
 
+// Sorted (lexicographically by dx, dy, dz) and unique. Varying fields ask for this once per
+// voxel per step, so the common small reach dedups through a bitmap over the stencil's box,
+// whose scan in index order is already lexicographic; wide reaches sort packed keys.
 void stencil_offsets(const ReadStencil& s, std::vector<std::array<int8_t, 3>>& out) {
-  out.clear();
-  out.push_back({0, 0, 0});
-  for (const Tap& t : s.taps) out.push_back({t.dx, t.dy, t.dz});
+  int lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+  auto grow = [&](int8_t x, int8_t y, int8_t z) {
+    const int o[3] = {x, y, z};
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::min(lo[a], o[a]);
+      hi[a] = std::max(hi[a], o[a]);
+    }
+  };
+  for (const Tap& t : s.taps) grow(t.dx, t.dy, t.dz);
   for (const auto& plane : s.candidate)
-    for (const auto& o : plane) out.push_back(o);
-  std::sort(out.begin(), out.end());
-  out.erase(std::unique(out.begin(), out.end()), out.end());
+    for (const auto& o : plane) grow(o[0], o[1], o[2]);
+  const int ey = hi[1] - lo[1] + 1, ez = hi[2] - lo[2] + 1;
+  const int cells = (hi[0] - lo[0] + 1) * ey * ez;
+  out.clear();
+  if (cells <= (1 << 16)) {
+    thread_local std::vector<uint64_t> bits;
+    bits.assign(size_t(cells + 63) / 64, 0);
+    auto mark = [&](int x, int y, int z) {
+      const int i = ((x - lo[0]) * ey + (y - lo[1])) * ez + (z - lo[2]);
+      bits[size_t(i) >> 6] |= uint64_t(1) << (i & 63);
+    };
+    mark(0, 0, 0);
+    for (const Tap& t : s.taps) mark(t.dx, t.dy, t.dz);
+    for (const auto& plane : s.candidate)
+      for (const auto& o : plane) mark(o[0], o[1], o[2]);
+    for (size_t w = 0; w < bits.size(); ++w)
+      for (uint64_t b = bits[w]; b; b &= b - 1) {
+        const int i = int(w * 64) + __builtin_ctzll(b);
+        const int z = i % ez, y = (i / ez) % ey, x = i / (ez * ey);
+        out.push_back({int8_t(x + lo[0]), int8_t(y + lo[1]), int8_t(z + lo[2])});
+      }
+    return;
+  }
+  // Offsets are within +-127: biased bytes packed high to low sort like (dx, dy, dz).
+  auto key = [](int x, int y, int z) { return uint32_t(x + 128) << 16 | uint32_t(y + 128) << 8 | uint32_t(z + 128); };
+  std::vector<uint32_t> keys;
+  keys.reserve(s.taps.size() + 28);
+  keys.push_back(key(0, 0, 0));
+  for (const Tap& t : s.taps) keys.push_back(key(t.dx, t.dy, t.dz));
+  for (const auto& plane : s.candidate)
+    for (const auto& o : plane) keys.push_back(key(o[0], o[1], o[2]));
+  std::sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  for (uint32_t k : keys) out.push_back({int8_t(int(k >> 16) - 128), int8_t(int((k >> 8) & 255) - 128), int8_t(int(k & 255) - 128)});
 }
 
 PlaneWeights normalised_weights(const std::array<float, 3>& w) {

@@ -284,6 +284,26 @@ TEST(Stencil, OffsetsIncludeCandidateSourcesAndTheVoxelItself) {
   EXPECT_EQ(got, (std::set<std::array<int8_t, 3>>{{0, 0, 0}, {1, 2, 3}, {-1, 0, 0}, {0, 4, 0}, {2, 2, 2}, {-5, 4, 0}}));
 }
 
+TEST(Stencil, OffsetsAreSortedAndUniqueForNarrowAndWideReaches) {
+  // Narrow stencils dedup through a bitmap over their box, wide ones (box > 2^16 voxels) by
+  // sorting: both give the same lexicographic order the dependency analysis relies on.
+  for (const int spread : {3, 120}) {
+    ReadStencil s;
+    s.n = 1;
+    s.taps = {Tap{int8_t(spread), int8_t(-spread), 1, 1.f}, Tap{-2, 1, int8_t(spread), 1.f},
+              Tap{int8_t(-spread), 0, 0, 1.f}, Tap{-2, 1, int8_t(spread), 1.f}, Tap{0, 0, 0, 1.f}};
+    s.begin = {0, 2, 4, 5};
+    for (auto& plane : s.candidate)
+      for (auto& o : plane) o = {1, int8_t(spread), -1};
+    std::vector<std::array<int8_t, 3>> offsets{{7, 7, 7}};
+    stencil_offsets(s, offsets);
+    std::set<std::array<int8_t, 3>> want{{0, 0, 0}, {1, int8_t(spread), -1}};
+    for (const Tap& t : s.taps) want.insert({t.dx, t.dy, t.dz});
+    const std::vector<std::array<int8_t, 3>> sorted(want.begin(), want.end());
+    EXPECT_EQ(offsets, sorted) << "spread " << spread;
+  }
+}
+
 TEST(Stencil, BuildIsDeterministicAndReusesTheOutput) {
   const Rot3 r = Rot3::from_quat(Quat::from_axis_angle(0.2, 0.9, -0.4, 2.1), {1.5, 1, 0.5});
   ReadStencil a, b;
