@@ -72,6 +72,8 @@ def main() -> int:
     ap.add_argument("--out", type=Path, default=None)
     ap.add_argument("--no-embark", action="store_true")
     ap.add_argument("--typicality", type=float, default=None)
+    ap.add_argument("--table-cache", type=Path, default=None,
+                    help="keep analysed tables here and reuse them (analysis dominates short runs)")
     ap.add_argument("--slice-args", default="", help="extra `solidtex slice` flags, e.g. \"--passes 1\"")
     args = ap.parse_args()
     build = args.build.resolve()
@@ -95,9 +97,11 @@ def main() -> int:
         tmp = Path(tmp)
         for ex in exemplars:
             name = ex.stem
-            table = tmp / f"{name}.stx"
             grain = ["--grain", "x"] if name in GRAIN_X else []
-            run([solidtex, "analyze", ex, *grain, "-o", table])
+            table = (args.table_cache or tmp) / f"{name}{'_grain_x' if grain else ''}.stx"
+            if not (args.table_cache and table.exists()):
+                table.parent.mkdir(parents=True, exist_ok=True)
+                run([solidtex, "analyze", ex, *grain, "-o", table])
             cuts = {"z": ["--axis", "z", "--at", "0"], "y": ["--axis", "y", "--at", "0"],
                     "x": ["--axis", "x", "--at", "0"], "oblique": ["--plane", OBLIQUE]}
             entry = {"exemplar": name, "grain": "x" if grain else "", "size": n, "cuts": {}}

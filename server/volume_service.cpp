@@ -458,17 +458,31 @@ VolumeService::~VolumeService() = default;
 namespace {
 
 // Appearance-changing defaults are written into a volume's stored spec, so that a later release
-// changing them never changes a stored volume's voxels: writes `value` as the params'
-// typicality when they give none and returns whether it did. A spec that is not an object, or
-// whose params are not, is left for parse_spec to refuse.
-bool pin_typicality(json& spec, double value) {
+// changing them never changes a stored volume's voxels: writes each (name, value) as the params'
+// value where they give none and returns whether it wrote any. A spec that is not an object,
+// or whose params are not, is left for parse_spec to refuse.
+bool pin_params(json& spec, const json& values) {
   if (!spec.is_object()) return false;
   json& params = spec["params"];
   if (params.is_null()) params = json::object();
-  if (!params.is_object() || params.contains("typicality")) return false;
-  params["typicality"] = value;
-  return true;
+  if (!params.is_object()) return false;
+  bool wrote = false;
+  for (const auto& [name, value] : values.items())
+    if (!params.contains(name)) {
+      params[name] = value;
+      wrote = true;
+    }
+  return wrote;
 }
+
+// The defaults a new volume pins (SynthesisParams), and the ones volumes stored before each
+// was pinned were synthesized with: typicality did not exist (0), and fine levels ran two
+// correction passes.
+json current_defaults() {
+  const SynthesisParams d;
+  return {{"typicality", d.typicality}, {"passes", d.passes}};
+}
+json legacy_defaults() { return {{"typicality", 0.0}, {"passes", 2}}; }
 
 }  // namespace
 
@@ -478,8 +492,8 @@ Status VolumeService::start(std::vector<std::string>* report) {
       SOLIDTEX_ASSIGN_OR_RETURN(std::string text, impl_->store.read_text(ResourceKind::kVolume, id, "volume.json"));
       SOLIDTEX_ASSIGN_OR_RETURN(json info, parse_json_text(text, "volume.json"));
       json spec = info["spec"];
-      // Volumes stored before the typicality penalty existed were synthesized without it.
-      if (pin_typicality(spec, 0.0)) {
+      // Volumes stored before a default was pinned keep the value they were synthesized with.
+      if (pin_params(spec, legacy_defaults())) {
         info["spec"] = spec;
         info["params"] = spec["params"];
       }
@@ -510,7 +524,7 @@ Status VolumeService::start(std::vector<std::string>* report) {
 Result<json> VolumeService::create(const std::string& spec_text) {
   SOLIDTEX_ASSIGN_OR_RETURN(json spec, parse_json_text(spec_text, "body"));
   if (spec.contains("id")) return Status(StatusCode::kInvalidArgument, "unknown key", "id");
-  pin_typicality(spec, SynthesisParams{}.typicality);
+  pin_params(spec, current_defaults());
   std::vector<uint8_t> field_bytes;
   json field_desc;
   SOLIDTEX_ASSIGN_OR_RETURN(auto v, impl_->parse_spec(spec, &field_bytes, &field_desc));

@@ -38,9 +38,12 @@
 
 namespace solidtex {
 
+// A voxel's matching color (RGB plus mask; channels beyond the table's are 0).
+using StateColor = std::array<float, 4>;
+
 struct VoxelState {
   CoordinateTriple triple;
-  std::array<float, 4> color{};  // matching color; channels beyond the table's are 0
+  StateColor color{};
 };
 
 struct Tap {
@@ -103,8 +106,8 @@ inline void gather_samples(const ReadStencil& st, Reader& read, float* g) {
     float acc[C] = {};
     for (int t = st.begin[size_t(q)]; t < st.begin[size_t(q) + 1]; ++t) {
       const Tap& tap = st.taps[size_t(t)];
-      const VoxelState& v = read(tap.dx, tap.dy, tap.dz);
-      for (int k = 0; k < C; ++k) acc[k] += tap.weight * v.color[size_t(k)];
+      const StateColor& v = read.color(tap.dx, tap.dy, tap.dz);
+      for (int k = 0; k < C; ++k) acc[k] += tap.weight * v[size_t(k)];
     }
     for (int k = 0; k < C; ++k) g[k] = acc[k];
     g += C;
@@ -112,8 +115,8 @@ inline void gather_samples(const ReadStencil& st, Reader& read, float* g) {
 }
 }  // namespace detail
 
-// Corrects one voxel. `read(dx, dy, dz)` returns the neighbour's state at the version the
-// history window names for that offset.
+// Corrects one voxel. `read.color(dx, dy, dz)` and `read.triple(dx, dy, dz)` return the
+// neighbour's matching color and triple at the version the history window names for that offset.
 template <class Reader>
 CoordinateTriple correct_voxel(const CorrectionContext& ctx, const ReadStencil& st, Reader& read, CorrectionScratch& s) {
   s.gathered.resize(size_t(3) * ctx.n * ctx.n * ctx.channels);
@@ -125,12 +128,12 @@ CoordinateTriple correct_voxel(const CorrectionContext& ctx, const ReadStencil& 
     default: detail::gather_samples<4>(st, read, g); break;
   }
   detail::project_planes(ctx, s);
-  const CoordinateTriple current = read(0, 0, 0).triple;
+  const CoordinateTriple current = read.triple(0, 0, 0);
   std::array<std::array<ExemplarPixel, 9>, 3> sources;
   for (int plane = 0; plane < 3; ++plane)
     for (int ab = 0; ab < 9; ++ab) {
       const auto& o = st.candidate[size_t(plane)][size_t(ab)];
-      const ExemplarPixel t = read(o[0], o[1], o[2]).triple.at[size_t(plane)];
+      const ExemplarPixel t = read.triple(o[0], o[1], o[2]).at[size_t(plane)];
       const int a = ab % 3 - 1, b = ab / 3 - 1;
       sources[size_t(plane)][size_t(ab)] = {t.x - ctx.spacing * a, t.y - ctx.spacing * b};
     }

@@ -5,6 +5,7 @@
 #include <numeric>
 
 #include "synthesis/correction.h"
+#include "synthesis/level_store.h"
 
 namespace solidtex {
 namespace {
@@ -12,7 +13,7 @@ namespace {
 constexpr int64_t kMaskTableBytesPerBrick = 4;   // VoxelMask: int32 pool index per brick of the box
 constexpr int64_t kMaskBrickBytes = 64;          // 512 bits
 constexpr int64_t kStoreTableBytesPerBrick = 8;  // LevelStore: a pointer per brick of the box
-constexpr int64_t kStateBytes = int64_t(sizeof(VoxelState)) + 1;  // state + instrumentation flag
+constexpr int64_t kStateBytes = LevelStore::kSlotBytes;  // triple + color + instrumentation flag
 
 int64_t sat_mul(int64_t a, int64_t b) {
   if (a == 0 || b == 0) return 0;

@@ -10,7 +10,8 @@ void LevelStore::allocate(const Voxel& p) {
   Brick*& b = table_[index_.brick_of(p)];
   if (b) return;
   auto nb = std::make_unique<Brick>();
-  nb->states.resize(size_t(512) * slots_);
+  nb->triples.resize(size_t(512) * slots_);
+  nb->colors.resize(size_t(512) * slots_);
   nb->flags = std::make_unique<std::atomic<uint8_t>[]>(size_t(512) * slots_);
   for (size_t i = 0; i < size_t(512) * slots_; ++i) nb->flags[i].store(0, std::memory_order_relaxed);
   b = nb.get();

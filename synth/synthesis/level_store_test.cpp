@@ -35,12 +35,12 @@ TEST(LevelStore, ValuesReadBackPerVoxelAndSlotAcrossNegativeBricks) {
   const auto all = voxels_of(box);
   for (const Voxel& p : all) store.allocate(p);
   for (const Voxel& p : all)
-    for (int s = 0; s < slots; ++s) store.at(p, s) = state_for(p, s);
+    for (int s = 0; s < slots; ++s) store.set(p, s, state_for(p, s));
   const LevelStore& cs = store;
   for (const Voxel& p : all) {
     ASSERT_TRUE(cs.has(p));
     for (int s = 0; s < slots; ++s)
-      ASSERT_TRUE(same(cs.at(p, s), state_for(p, s))) << p.x << "," << p.y << "," << p.z << " slot " << s;
+      ASSERT_TRUE(same(cs.state(p, s), state_for(p, s))) << p.x << "," << p.y << "," << p.z << " slot " << s;
   }
 }
 
@@ -51,24 +51,24 @@ TEST(LevelStore, SlotsAndBricksAreIndependent) {
   const Voxel a{-1, 0, 0}, b{7, 0, 0}, c{-8, -8, -8}, d{0, 0, 0}, e{-9, -9, -9}, f{7, 7, 7};
   for (const Voxel& p : {a, b, c, d, e, f}) store.allocate(p);
   for (const Voxel& p : {a, b, c, d, e, f})
-    for (int s = 0; s < 2; ++s) store.at(p, s) = VoxelState{};
-  store.at(a, 0) = state_for(a, 0);
+    for (int s = 0; s < 2; ++s) store.set(p, s, VoxelState{});
+  store.set(a, 0, state_for(a, 0));
   // Writing slot 0 of `a` leaves slot 1 and every other voxel untouched.
-  EXPECT_TRUE(same(store.at(a, 1), VoxelState{}));
+  EXPECT_TRUE(same(store.state(a, 1), VoxelState{}));
   for (const Voxel& p : {b, c, d, e, f})
-    for (int s = 0; s < 2; ++s) EXPECT_TRUE(same(store.at(p, s), VoxelState{})) << p.x << " " << s;
-  store.at(a, 1) = state_for(a, 1);
-  store.at(b, 0) = state_for(b, 0);
-  store.at(e, 1) = state_for(e, 1);
-  store.at(c, 0) = state_for(c, 0);
-  EXPECT_TRUE(same(store.at(a, 0), state_for(a, 0)));
-  EXPECT_TRUE(same(store.at(a, 1), state_for(a, 1)));
-  EXPECT_TRUE(same(store.at(b, 0), state_for(b, 0)));
-  EXPECT_TRUE(same(store.at(c, 0), state_for(c, 0)));
-  EXPECT_TRUE(same(store.at(e, 1), state_for(e, 1)));
-  EXPECT_TRUE(same(store.at(e, 0), VoxelState{}));
-  EXPECT_TRUE(same(store.at(d, 0), VoxelState{}));
-  EXPECT_TRUE(same(store.at(f, 1), VoxelState{}));
+    for (int s = 0; s < 2; ++s) EXPECT_TRUE(same(store.state(p, s), VoxelState{})) << p.x << " " << s;
+  store.set(a, 1, state_for(a, 1));
+  store.set(b, 0, state_for(b, 0));
+  store.set(e, 1, state_for(e, 1));
+  store.set(c, 0, state_for(c, 0));
+  EXPECT_TRUE(same(store.state(a, 0), state_for(a, 0)));
+  EXPECT_TRUE(same(store.state(a, 1), state_for(a, 1)));
+  EXPECT_TRUE(same(store.state(b, 0), state_for(b, 0)));
+  EXPECT_TRUE(same(store.state(c, 0), state_for(c, 0)));
+  EXPECT_TRUE(same(store.state(e, 1), state_for(e, 1)));
+  EXPECT_TRUE(same(store.state(e, 0), VoxelState{}));
+  EXPECT_TRUE(same(store.state(d, 0), VoxelState{}));
+  EXPECT_TRUE(same(store.state(f, 1), VoxelState{}));
 }
 
 TEST(LevelStore, HasOnlyForAllocatedBricksInsideTheBox) {
@@ -98,7 +98,7 @@ TEST(LevelStore, BytesGrowPerBrickAndWithSlots) {
   EXPECT_EQ(s1.bytes(), 0);
   s1.allocate({0, 0, 0});
   const int64_t one = s1.bytes();
-  EXPECT_GE(one, 512 * int64_t(sizeof(VoxelState)));
+  EXPECT_GE(one, 512 * int64_t(sizeof(CoordinateTriple) + sizeof(StateColor)));
   for (int x = 1; x < 8; ++x) s1.allocate({x, x, x});  // same brick
   EXPECT_EQ(s1.bytes(), one);
   s1.allocate({-1, 0, 0});
@@ -147,7 +147,7 @@ TEST(LevelStore, NeighborhoodMatchesAtOverTheFullReach) {
   const auto all = voxels_of(box);
   for (const Voxel& p : all) store.allocate(p);
   for (const Voxel& p : all)
-    for (int s = 0; s < slots; ++s) store.at(p, s) = state_for(p, s);
+    for (int s = 0; s < slots; ++s) store.set(p, s, state_for(p, s));
   const LevelStore& cs = store;
   constexpr int R = LevelStore::Neighborhood::kReach;
   static_assert(R >= 1 && R <= 8, "the box and centres below assume a reach of at most one brick");
@@ -160,11 +160,10 @@ TEST(LevelStore, NeighborhoodMatchesAtOverTheFullReach) {
         for (int dx = -R; dx <= R; ++dx) {
           const Voxel q{c.x + dx, c.y + dy, c.z + dz};
           for (int s = 0; s < slots; ++s) {
-            const VoxelState& a = near.at(dx, dy, dz, s);
-            ASSERT_EQ(&a, &cs.at(q, s)) << "centre " << c.x << "," << c.y << "," << c.z << " offset " << dx << ","
-                                        << dy << "," << dz << " slot " << s;
-            ASSERT_TRUE(same(a, state_for(q, s)));
-            ASSERT_EQ(near.find(dx, dy, dz, s), &a);
+            ASSERT_EQ(near.color(dx, dy, dz, s), &cs.color(q, s)) << "centre " << c.x << "," << c.y << "," << c.z
+                                                                  << " offset " << dx << "," << dy << "," << dz << " slot " << s;
+            ASSERT_EQ(near.triple(dx, dy, dz, s), &cs.triple(q, s));
+            ASSERT_TRUE(same(cs.state(q, s), state_for(q, s)));
             ++compared;
           }
         }
@@ -178,42 +177,43 @@ TEST(LevelStore, NeighborhoodAtTheBoxEdgeReadsAllocatedNeighbours) {
   const VoxelBox box{{-8, -8, -8}, {16, 16, 16}};
   LevelStore store(box, 1);
   for (const Voxel& p : voxels_of(box)) store.allocate(p);
-  for (const Voxel& p : voxels_of(box)) store.at(p, 0) = state_for(p, 0);
+  for (const Voxel& p : voxels_of(box)) store.set(p, 0, state_for(p, 0));
   const Voxel c{-8, -8, -8};
   const LevelStore::Neighborhood near(store, c);
   constexpr int R = LevelStore::Neighborhood::kReach;
   for (int dz = 0; dz <= R; ++dz)
     for (int dy = 0; dy <= R; ++dy)
       for (int dx = 0; dx <= R; ++dx)
-        ASSERT_TRUE(same(near.at(dx, dy, dz, 0), state_for({c.x + dx, c.y + dy, c.z + dz}, 0)));
+        ASSERT_TRUE(same({*near.triple(dx, dy, dz, 0), *near.color(dx, dy, dz, 0)}, state_for({c.x + dx, c.y + dy, c.z + dz}, 0)));
   // Offsets into the bricks below the box find nothing.
-  EXPECT_EQ(near.find(-1, 0, 0, 0), nullptr);
-  EXPECT_EQ(near.find(0, -1, 0, 0), nullptr);
-  EXPECT_EQ(near.find(0, 0, -R, 0), nullptr);
-  EXPECT_EQ(near.find(-1, -1, -1, 0), nullptr);
-  EXPECT_NE(near.find(R, R, R, 0), nullptr);
+  EXPECT_EQ(near.color(-1, 0, 0, 0), nullptr);
+  EXPECT_EQ(near.color(0, -1, 0, 0), nullptr);
+  EXPECT_EQ(near.color(0, 0, -R, 0), nullptr);
+  EXPECT_EQ(near.color(-1, -1, -1, 0), nullptr);
+  EXPECT_NE(near.color(R, R, R, 0), nullptr);
 }
 
-TEST(LevelStore, FindIsNullOutsideTheBoxAndInUnallocatedBricks) {
+TEST(LevelStore, HasIsFalseOutsideTheBoxAndInUnallocatedBricks) {
   const VoxelBox box{{-16, -16, -16}, {16, 16, 16}};
   LevelStore store(box, 2);
   store.allocate({-1, -1, -1});  // brick [-8, 0)^3
-  store.at({-1, -1, -1}, 1) = state_for({-1, -1, -1}, 1);
+  store.set({-1, -1, -1}, 1, state_for({-1, -1, -1}, 1));
   const LevelStore& cs = store;
-  ASSERT_NE(cs.find({-1, -1, -1}, 1), nullptr);
-  EXPECT_EQ(cs.find({-1, -1, -1}, 1), &cs.at({-1, -1, -1}, 1));
-  EXPECT_TRUE(same(*cs.find({-1, -1, -1}, 1), state_for({-1, -1, -1}, 1)));
-  EXPECT_EQ(cs.find({-8, -8, -8}, 0), &cs.at({-8, -8, -8}, 0));
-  EXPECT_EQ(cs.find({0, -1, -1}, 0), nullptr);   // next brick, not allocated
-  EXPECT_EQ(cs.find({-9, -1, -1}, 0), nullptr);  // previous brick, not allocated
-  EXPECT_EQ(cs.find({-1, -1, -17}, 0), nullptr); // outside the box
-  EXPECT_EQ(cs.find({16, 0, 0}, 0), nullptr);    // outside the box
-  // Neighborhood::find: null where the neighbouring brick is missing, the voxel otherwise.
+  ASSERT_TRUE(cs.has({-1, -1, -1}));
+  EXPECT_TRUE(same(cs.state({-1, -1, -1}, 1), state_for({-1, -1, -1}, 1)));
+  EXPECT_TRUE(cs.has({-8, -8, -8}));
+  EXPECT_FALSE(cs.has({0, -1, -1}));    // next brick, not allocated
+  EXPECT_FALSE(cs.has({-9, -1, -1}));   // previous brick, not allocated
+  EXPECT_FALSE(cs.has({-1, -1, -17}));  // outside the box
+  EXPECT_FALSE(cs.has({16, 0, 0}));     // outside the box
+  // Neighborhood: null where the neighbouring brick is missing, the voxel otherwise.
   const LevelStore::Neighborhood near(cs, {-4, -4, -4});
-  EXPECT_EQ(near.find(3, 3, 3, 1), &cs.at({-1, -1, -1}, 1));
-  EXPECT_EQ(near.find(4, 0, 0, 0), nullptr);
-  EXPECT_EQ(near.find(-5, 0, 0, 0), nullptr);
-  EXPECT_EQ(near.find(0, -8, 0, 0), nullptr);
+  EXPECT_EQ(near.color(3, 3, 3, 1), &cs.color({-1, -1, -1}, 1));
+  EXPECT_EQ(near.triple(3, 3, 3, 1), &cs.triple({-1, -1, -1}, 1));
+  EXPECT_EQ(near.color(4, 0, 0, 0), nullptr);
+  EXPECT_EQ(near.triple(4, 0, 0, 0), nullptr);
+  EXPECT_EQ(near.color(-5, 0, 0, 0), nullptr);
+  EXPECT_EQ(near.color(0, -8, 0, 0), nullptr);
 }
 
 }  // namespace

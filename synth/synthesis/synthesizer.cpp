@@ -81,6 +81,49 @@ class SetChecks {
   int64_t unread_ = 0;
 };
 
+// What a correction reads (correction.h's reader): neighbours' colors and triples at the slots
+// the step's window names, through the 27 cached bricks when the stencil reaches no further.
+// A read outside the sets is a dependency-analysis bug: it is flagged and reads a dummy state,
+// never memory outside the store.
+struct StoreReader {
+  LevelStore& store;  // non-const for the instrumented mode's read flags
+  const LevelSchedule& sch;
+  const HistoryWindow::Resolved& window;
+  const LevelStore::Neighborhood& near;
+  const NeighbourSlots& slots;
+  const Voxel p;
+  const bool near_reaches;
+  SetChecks& checks;
+  std::atomic<bool>& outside_store;
+
+  int slot_of(int dx, int dy, int dz, Voxel& q) const {
+    q = {p.x + dx, p.y + dy, p.z + dz};
+    return near_reaches ? slots.slot(dx, dy, dz) : sch.slot(q, window.version_of(q));
+  }
+  const StateColor& color(int dx, int dy, int dz) const {
+    Voxel q;
+    const int slot = slot_of(dx, dy, dz, q);
+    if (!checks.read(store, q, slot)) return dummy_state().color;
+    const StateColor* c = near_reaches ? near.color(dx, dy, dz, slot) : (store.has(q) ? &store.color(q, slot) : nullptr);
+    if (!c) {
+      outside_store = true;
+      return dummy_state().color;
+    }
+    return *c;
+  }
+  const CoordinateTriple& triple(int dx, int dy, int dz) const {
+    Voxel q;
+    const int slot = slot_of(dx, dy, dz, q);
+    if (!checks.read(store, q, slot)) return dummy_state().triple;
+    const CoordinateTriple* t = near_reaches ? near.triple(dx, dy, dz, slot) : (store.has(q) ? &store.triple(q, slot) : nullptr);
+    if (!t) {
+      outside_store = true;
+      return dummy_state().triple;
+    }
+    return *t;
+  }
+};
+
 // Targets whose voxels lie farther apart than this (finest voxels, 26-connected cells) are
 // synthesized piece by piece: one piece's dependency sets never span the gap between them.
 constexpr int kPieceCell = 256;
@@ -137,9 +180,9 @@ std::unique_ptr<LevelStore> make_level_store(const LevelPass& pass, const LevelD
   for (size_t i = 0; i < dep.cache_hits.size(); ++i) {
     const Voxel& p = dep.cache_hits[i];
     store->allocate(p);
-    VoxelState& s = store->at(p, sch.slot(p, sch.final_version()));
-    s.triple = dep.cached[i];
-    matching_color(*ctx.level, s.triple, ctx.channels, ctx.color_weights, s.color.data());
+    const int slot = sch.slot(p, sch.final_version());
+    store->triple(p, slot) = dep.cached[i];
+    matching_color(*ctx.level, dep.cached[i], ctx.channels, ctx.color_weights, store->color(p, slot).data());
   }
   return store;
 }
@@ -156,22 +199,21 @@ Status initialise_level(const LevelPass& pass, const LevelDependencies& dep, Lev
   tbb::parallel_for(tbb::blocked_range<size_t>(0, voxels.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t i = r.begin(); i != r.end(); ++i) {
       const Voxel& p = voxels[i];
-      VoxelState& s = store.at(p, 0);
+      CoordinateTriple& triple = store.triple(p, 0);
       if (l.index == 0) {
-        s.triple = init_triple(pass.table, p, frames.rotation(l, p), pass.params);
+        triple = init_triple(pass.table, p, frames.rotation(l, p), pass.params);
       } else {
         const Voxel P = parent_of(p);
         const PyramidLevel pl{l.index - 1};
         const int pslot = parent_sch->slot(P, parent_sch->final_version());
         if (!checks.read(*parent_store, P, pslot)) continue;
-        const VoxelState* parent = parent_store->find(P, pslot);
-        if (!parent) {
+        if (!parent_store->has(P)) {
           missing_parent = true;
           continue;
         }
-        s.triple = upsample_triple(pass.table, l, p, parent->triple, frames.rotation(pl, P));
+        triple = upsample_triple(pass.table, l, p, parent_store->triple(P, pslot), frames.rotation(pl, P));
       }
-      matching_color(*ctx.level, s.triple, ctx.channels, ctx.color_weights, s.color.data());
+      matching_color(*ctx.level, triple, ctx.channels, ctx.color_weights, store.color(p, 0).data());
     }
   });
   if (missing_parent) return Status(StatusCode::kInternal, "an upsampled voxel's parent is outside the coarser level's sets");
@@ -207,20 +249,11 @@ Status correct_level(const LevelPass& pass, const LevelDependencies& dep, LevelS
         const HistoryWindow::Resolved window = step.window.resolve(p);
         const LevelStore::Neighborhood near(store, p);
         const NeighbourSlots slots(sch, window, p);
-        auto read = [&](int dx, int dy, int dz) -> const VoxelState& {
-          const Voxel q{p.x + dx, p.y + dy, p.z + dz};
-          const int slot = near_reaches ? slots.slot(dx, dy, dz) : sch.slot(q, window.version_of(q));
-          if (!checks.read(store, q, slot)) return dummy_state();
-          const VoxelState* s = near_reaches ? near.find(dx, dy, dz, slot) : store.find(q, slot);
-          if (!s) {  // outside the sets: a dependency-analysis bug, never a wild read
-            outside_store = true;
-            return dummy_state();
-          }
-          return *s;
-        };
-        VoxelState& out = store.at(p, sch.slot(p, v));
-        out.triple = correct_voxel(ctx, st, read, scratch);
-        matching_color(*ctx.level, out.triple, ctx.channels, ctx.color_weights, out.color.data());
+        StoreReader read{store, sch, window, near, slots, p, near_reaches, checks, outside_store};
+        const int out = sch.slot(p, v);
+        const CoordinateTriple t = correct_voxel(ctx, st, read, scratch);
+        store.triple(p, out) = t;
+        matching_color(*ctx.level, t, ctx.channels, ctx.color_weights, store.color(p, out).data());
       }
     });
     if (poller.stopped()) return Status(StatusCode::kCancelled, "synthesis cancelled");
@@ -237,7 +270,7 @@ void write_back(const LevelPass& pass, const LevelDependencies& dep, const Level
   std::vector<Voxel> finals = dep.needed[size_t(V)].to_vector();
   std::vector<CoordinateTriple> triples;
   triples.reserve(finals.size());
-  for (const Voxel& p : finals) triples.push_back(store.at(p, sch.slot(p, V)).triple);
+  for (const Voxel& p : finals) triples.push_back(store.triple(p, sch.slot(p, V)));
   cache.insert(pass.level, finals, triples);
 }
 
@@ -362,7 +395,7 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize_piece(const Ta
     const Voxel& p = target.voxels[i];
     const int slot = fsch.slot(p, fsch.final_version());
     checks.read(*parent, p, slot);
-    output_color(*table_, parent->at(p, slot).triple, fctx.color_weights, voxel_rgb[i].data());
+    output_color(*table_, parent->triple(p, slot), fctx.color_weights, voxel_rgb[i].data());
   }
   checks.count_unread(fsch, deps[size_t(finest.index)], *parent);
   stats.unsound_reads = checks.unsound();

@@ -90,24 +90,25 @@ def test_sigterm_exits_cleanly_and_restarts(server, exemplars):
     assert np.array_equal(b.client.slice(vol["id"], "z", 1, (16, 16)), before)
 
 
-def test_volumes_stored_before_typicality_keep_their_voxels(server, exemplars):
-    """New volumes pin the typicality default they were made with; a volume.json written before
-    the penalty existed (no typicality anywhere) comes back with typicality 0, the matching its
-    voxels were synthesized with, so no release changes a stored volume's look."""
+def test_volumes_stored_before_a_default_changed_keep_their_voxels(server, exemplars):
+    """New volumes pin the appearance-changing defaults they were made with (typicality, fine
+    passes); a volume.json written before those were pinned (neither anywhere) comes back with
+    the values its voxels were synthesized with (typicality 0, two passes), so no release
+    changes a stored volume's look."""
     a = server()
     c = a.client
     ex = upload_ready(c, exemplars["spots"])
     vol = c.create_volume(exemplar=ex["id"], seed=4)
-    assert vol["params"] == {"typicality": 0.5}, vol
-    plain = c.create_volume(exemplar=ex["id"], seed=4, params={"typicality": 0})
-    want = c.slice(plain["id"], "z", 2, (24, 24))
-    assert not np.array_equal(c.slice(vol["id"], "z", 2, (24, 24)), want), "typicality changed nothing"
+    assert vol["params"] == {"typicality": 0.5, "passes": 1}, vol
+    legacy = c.create_volume(exemplar=ex["id"], seed=4, params={"typicality": 0, "passes": 2})
+    want = c.slice(legacy["id"], "z", 2, (24, 24))
+    assert not np.array_equal(c.slice(vol["id"], "z", 2, (24, 24)), want), "the defaults changed nothing"
     assert a.stop(grace=10) == 0
     path = next(p for p in a.data_dir.rglob("volume.json") if vol["id"] in str(p))
     info = json.loads(path.read_text())
-    del info["params"]["typicality"], info["spec"]["params"]["typicality"]
+    del info["params"], info["spec"]["params"]
     path.write_text(json.dumps(info))
     b = server(data_dir=a.data_dir)
     got = b.client.get_volume(vol["id"])
-    assert got["params"]["typicality"] == 0, got
+    assert got["params"] == {"typicality": 0, "passes": 2}, got
     assert np.array_equal(b.client.slice(vol["id"], "z", 2, (24, 24)), want)
