@@ -176,6 +176,8 @@ int main(int argc, char** argv) {
           }
         }
         const auto c = s->cache().counters();
+        int64_t cached_voxels = 0;
+        for (int64_t n : c.voxels_per_level) cached_voxels += n;
         cuts_out.push_back({{"field", f.name},
                             {"threads", threads > 0 ? threads : tbb::this_task_arena::max_concurrency()},
                             {"size", side},
@@ -188,7 +190,9 @@ int main(int argc, char** argv) {
                             {"next_cut_levels", level_json(next)},
                             {"same_cut_again_seconds", again.seconds},
                             {"cache_bytes", c.bytes},
-                            {"cache_bricks", c.bricks}});
+                            {"cache_bricks", c.bricks},
+                            {"cache_voxels", cached_voxels},
+                            {"cache_bytes_per_voxel", cached_voxels > 0 ? double(c.bytes) / double(cached_voxels) : 0.0}});
         std::cerr << f.name << " threads " << threads << ": cold " << cold.seconds << " s, next " << next.seconds
                   << " s, again " << again.seconds << " s\n";
       }

@@ -144,7 +144,7 @@ S = {
      "exemplars": {"type": "array", "items": {"type": "string"}}, "label": {"type": "string"},
      "field": {"type": "object", "description": "Where the field came from: {\"kind\": \"identity\"}, {\"kind\": \"spec\", \"spec\"} or {\"kind\": \"stored\", \"id\", \"revision\"} (the volume keeps its own copy of that revision).", "properties": {"kind": {"type": "string", "enum": ["identity", "spec", "stored"]}, "spec": {"type": "string"}, "id": {"type": "string"}, "revision": {"type": "integer"}}},
      "field_description": {"type": "string", "description": "Human-readable description of the field, e.g. 'identity' or 'quat:0.92,0,0,0.38'."},
-     "seed": {"type": "integer"}, "params": {"type": "object", "description": "The synthesis params as given, with `typicality` pinned to the default it was created with (0 for volumes stored before it existed), so later defaults never change a stored volume."}}},
+     "seed": {"type": "integer"}, "params": {"type": "object", "description": "The synthesis params as given, with the appearance-changing defaults pinned to the values it was created with (`typicality`, `passes`; volumes stored before they were pinned come back with typicality 0 and 2 passes, what their voxels were made with), so later defaults never change a stored volume."}}},
  "Cut": {"type": "object", "additionalProperties": False, "required": ["origin", "u", "v", "size"],
      "description": f"The far corner origin + W*u + H*v must lie within +-2^28 too (else 400); W*H at most --max-voxels (else 422).",
      "properties": {
@@ -179,7 +179,7 @@ S = {
      "feature_angle_degrees": number(1, 179, default=60),
      "curves": {"type": "array", "description": "features: user polylines on the surface (mesh coordinates); normals are taken from the nearest vertices.", "items": {"type": "array", "items": {"type": "array", "items": {"type": "number"}, "minItems": 3, "maxItems": 3}}}}},
  "Stats": {"type": "object", "properties": {"volume": {"type": "string"}, "levels": {"type": "array", "items": {"type": "object", "properties": {"level": {"type": "integer"}, "voxels_synthesized": {"type": "integer"}, "cached_voxels": {"type": "integer"}}}},
-     "cache": {"type": "object", "description": "The volume's voxel cache: bytes is all it holds (bricks of 8^3 voxels), within its share of --cache-mb (budget_bytes).", "properties": {"bytes": {"type": "integer"}, "budget_bytes": {"type": "integer"}, "hits": {"type": "integer"}, "misses": {"type": "integer"}, "bricks": {"type": "integer"}, "evicted_bricks": {"type": "integer"}}},
+     "cache": {"type": "object", "description": "The volume's voxel cache: bytes is all it holds (bricks of 8^3 voxels), within its share of --cache-mb (budget_bytes); bytes_per_voxel is bytes over the cached voxels of every level (12 per voxel in full bricks, more in partly filled ones).", "properties": {"bytes": {"type": "integer"}, "budget_bytes": {"type": "integer"}, "bytes_per_voxel": {"type": "number"}, "hits": {"type": "integer"}, "misses": {"type": "integer"}, "bricks": {"type": "integer"}, "evicted_bricks": {"type": "integer"}}},
      "state": ref("VolumeState"),
      "requests": {"type": "integer"}, "recent": {"type": "array", "description": "The last requests (newest last): kind, target voxels and dependent-set sizes per level.", "items": {"type": "object"}}}},
  "VolumeState": {"type": "object", "additionalProperties": False,

@@ -697,6 +697,9 @@ Result<json> VolumeService::stats(const std::string& id) const {
       if (cached.size() < c.voxels_per_level.size()) cached.resize(c.voxels_per_level.size(), 0);
       for (size_t l = 0; l < c.voxels_per_level.size(); ++l) cached[l] += c.voxels_per_level[l];
     }
+  int64_t cached_total = 0;
+  for (int64_t n : cached) cached_total += n;
+  cache["bytes_per_voxel"] = cached_total > 0 ? double(cache["bytes"].get<int64_t>()) / double(cached_total) : 0.0;
   std::lock_guard<std::mutex> g(v->stats_mutex);
   json levels = json::array();
   for (size_t l = 0; l < std::max(cached.size(), v->voxels_per_level.size()); ++l)

@@ -40,7 +40,8 @@ TEST(HistoryWindow, IntersectionIsTheElementwiseMinimum) {
 }
 
 TEST(LevelSchedule, DualGridStepsSlotsAndBarriers) {
-  SynthesisParams p;  // dual-grid, 2 passes, 8 subpasses
+  SynthesisParams p;  // dual-grid, 8 subpasses
+  p.passes = 2;       // one grid pass, one dual pass
   const LevelSchedule fine = LevelSchedule::make(1, p);
   ASSERT_EQ(fine.final_version(), 16);
   EXPECT_EQ(fine.slot_count(), 3);
@@ -62,6 +63,12 @@ TEST(LevelSchedule, DualGridStepsSlotsAndBarriers) {
   for (const auto& s : coarse.steps()) EXPECT_FALSE(s.window.has_barrier());
   p.scheme = Scheme::kPlain;
   EXPECT_EQ(LevelSchedule::make(2, p).final_version(), 2);
+  // The default single fine pass is the grid pass alone: 8 steps, barrier 0, no dual cells.
+  const LevelSchedule one = LevelSchedule::make(1, SynthesisParams{});
+  ASSERT_EQ(one.final_version(), 8);
+  EXPECT_EQ(one.slot_count(), 2);
+  EXPECT_EQ(one.steps()[7].window.version(edge, 1, 0, 0), 0);
+  EXPECT_EQ(one.steps()[7].window.version(edge, -1, 0, 0), 7);
 }
 
 TEST(NeighbourSlots, EqualTheSchedulesSlotOfTheWindowsVersionForEveryOffset) {

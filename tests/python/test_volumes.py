@@ -106,6 +106,9 @@ def test_repeated_slice_is_cached(shared):
     assert after["cache"]["hits"] - mid["cache"]["hits"] == 16 * 16, (mid["cache"], after["cache"])
     assert after["cache"]["misses"] == mid["cache"]["misses"], (mid["cache"], after["cache"])
     assert after["cache"]["bytes"] > 0, after
+    cached = sum(lv["cached_voxels"] for lv in after["levels"])
+    assert after["cache"]["bytes_per_voxel"] == pytest.approx(after["cache"]["bytes"] / cached), after
+    assert after["cache"]["bytes_per_voxel"] >= 12, after  # three planes' 16-bit x, y per voxel
     assert after["requests"] == mid["requests"] + 1 == before["requests"] + 2, after
     assert after["recent"][-1]["voxels"] == 0, after["recent"][-1]
 
