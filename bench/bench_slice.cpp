@@ -4,7 +4,7 @@
 //    512x512 oblique cut under plain, subpass and dual-grid correction (sets only);
 // 2. full synthesis of a 128x128 cut: corrections per second, paper and coherent matchers;
 // 3. per field (identity, a rotated constant field, a sketched ring): a cold 256x256 cut, the
-//    adjacent cut, the same cut again; the identity cold cut on 1 thread too.
+//    adjacent cut, the same cut again, the cut two over; the identity cold cut on 1 thread too.
 #include <nlohmann/json.hpp>
 #include <sys/resource.h>
 
@@ -150,7 +150,8 @@ int main(int argc, char** argv) {
 
   // 3. New cuts as a user meets them, per field: a cold cut on a fresh synthesizer, the cut
   //    next to it (at z + 1: coarse levels and most fine dependencies cached), the same cut
-  //    again (all from the cache); the identity field's cold cut also on one thread.
+  //    again (all from the cache), then the cut at z + 2 (the subpass parity the first cut's
+  //    corrections left final in the cache); the identity field's cold cut also on one thread.
   {
     const int side = quick ? 96 : 256;
     nlohmann::json cuts_out = nlohmann::json::array();
@@ -167,8 +168,8 @@ int main(int argc, char** argv) {
         std::unique_ptr<tbb::global_control> limit;
         if (threads > 0) limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, size_t(threads));
         auto s = make(*table, Scheme::kDualGrid, Matcher::kPaper, int64_t(4) << 30, f.field);
-        SynthesisStats cold, next, again;
-        for (auto [at, st] : {std::pair{0, &cold}, std::pair{1, &next}, std::pair{1, &again}}) {
+        SynthesisStats cold, next, again, second;
+        for (auto [at, st] : {std::pair{0, &cold}, std::pair{1, &next}, std::pair{1, &again}, std::pair{2, &second}}) {
           auto r = s->synthesize(TargetSet::axis_cut('z', at, 0, 0, side, side).value(), null_interrupter(), st);
           if (!r) {
             std::cerr << r.status().to_string() << "\n";
@@ -189,6 +190,8 @@ int main(int argc, char** argv) {
                             {"next_cut_seconds", next.seconds},
                             {"next_cut_levels", level_json(next)},
                             {"same_cut_again_seconds", again.seconds},
+                            {"cut_at_plus_2_seconds", second.seconds},
+                            {"cut_at_plus_2_levels", level_json(second)},
                             {"cache_bytes", c.bytes},
                             {"cache_bricks", c.bricks},
                             {"cache_voxels", cached_voxels},

@@ -264,13 +264,24 @@ Status correct_level(const LevelPass& pass, const LevelDependencies& dep, LevelS
 }
 
 // Final versions go to the cache; by purity any later request would compute the same values.
+// Not only the sets' final versions: a voxel that no step after v updates (its slot at v is its
+// final slot) holds its final value in needed[v] already. With one correction pass that is every
+// voxel a correction produced, so a cut leaves voxels around it final in the cache. (Which
+// ones follows the subpass order: a z cut's corrections run before the odd-z classes, so the
+// cut at z + 2 finds most of itself, the cut at z + 1 only its coarser levels.)
 void write_back(const LevelPass& pass, const LevelDependencies& dep, const LevelStore& store, VoxelCache& cache) {
   const LevelSchedule& sch = pass.schedule;
   const int V = sch.final_version();
-  std::vector<Voxel> finals = dep.needed[size_t(V)].to_vector();
+  VoxelMask taken(dep.box);
+  std::vector<Voxel> finals;
   std::vector<CoordinateTriple> triples;
-  triples.reserve(finals.size());
-  for (const Voxel& p : finals) triples.push_back(store.triple(p, sch.slot(p, V)));
+  for (int v = V; v >= 0; --v)
+    for (const Voxel& p : dep.needed[size_t(v)].to_vector()) {
+      const int slot = sch.slot(p, v);
+      if (slot != sch.slot(p, V) || !taken.insert(p)) continue;
+      finals.push_back(p);
+      triples.push_back(store.triple(p, slot));
+    }
   cache.insert(pass.level, finals, triples);
 }
 

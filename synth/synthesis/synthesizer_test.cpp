@@ -114,6 +114,26 @@ TEST_F(SynthesizerTest, ThreadsCacheStateAndPiecesDoNotChangeBits) {
   EXPECT_EQ(one, whole);
 }
 
+TEST_F(SynthesizerTest, NeighbouringCutFindsItsVoxelsFinalInTheCacheWithTheSameBits) {
+  // A cut caches every voxel whose value is final, not only its own: with one pass, every voxel
+  // a correction produced. The cut at z + 2 (z + 1 has the other subpass parity, which the
+  // corrections of z ran before) then finds most of itself in the cache (measured: 300 of 400
+  // finest voxels), and what it finds must equal a cold synthesizer's values bit for bit.
+  for (const int passes : {1, 2}) {
+    SynthesisParams p = small_params();
+    p.passes = passes;
+    auto warm = make(table_, "quat:0.9,0.1,0.3,0.2", p);
+    cut(*warm, 'z', 2, 0, 0, 20, 20);
+    SynthesisStats st;
+    const auto next = cut(*warm, 'z', 4, 0, 0, 20, 20, &st);
+    const LevelStats& finest = st.levels.back();
+    RecordProperty("finest_hits_passes_" + std::to_string(passes), std::to_string(finest.cache_hits));
+    if (passes == 1) EXPECT_GT(finest.cache_hits, finest.needed_final / 4) << "the cut next door reused little";
+    auto cold = make(table_, "quat:0.9,0.1,0.3,0.2", p, 0);
+    EXPECT_EQ(next, cut(*cold, 'z', 4, 0, 0, 20, 20)) << passes << " passes";
+  }
+}
+
 TEST_F(SynthesizerTest, TinyCacheBudgetEvictsBricksAndKeepsResults) {
   auto roomy = make(table_, "identity", small_params(), 64 << 20);
   auto tiny = make(table_, "identity", small_params(), 64 << 10);  // 64 KiB: about ten leaves

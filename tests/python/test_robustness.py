@@ -152,9 +152,11 @@ def test_field_solve_honours_its_deadline(srv):
 
 
 def test_synthesis_honours_its_deadline(srv):
-    vid = create_volume(srv, seed=11).json()["id"]
+    # Three fine passes and a 256^2 cut: far more than the 1 s deadline whatever the kernel's
+    # speed (one default pass does a 160^2 cut within it now).
+    vid = create_volume(srv, seed=11, params={"passes": 3}).json()["id"]
     t0 = time.monotonic()
-    r = slice_of(srv, vid, size="160,160", timeout=1)
+    r = slice_of(srv, vid, size="256,256", timeout=1)
     took = time.monotonic() - t0
     assert_error(r, 504, field_contains="timeout")
     assert took < 2.0, took
