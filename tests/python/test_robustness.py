@@ -67,6 +67,20 @@ def test_typicality_at_its_documented_extremes(srv):
     alive(srv)
 
 
+def test_passes_at_their_documented_extremes(srv):
+    # [0, 8] both synthesize and are stored as given (the default, 1, is pinned when absent);
+    # anything outside, or not an integer, is a 400 naming the field
+    for value in (0, 8):
+        r = create_volume(srv, params={"passes": value})
+        assert r.status_code == 201, r.text
+        assert r.json()["params"]["passes"] == value
+        got = slice_of(srv, r.json()["id"], size="8,8")
+        assert got.status_code == 200, got.text
+    for value in (-1, 9, 1.5, "1", None, [1]):
+        assert_error(create_volume(srv, params={"passes": value}), 400, "invalid_argument", "params.passes")
+    alive(srv)
+
+
 @pytest.mark.parametrize("spec", ["identity;scale:2.1,1,1", "axis:0,0,1,30;scale:3,1,1"])
 def test_stretched_fields_synthesize_instead_of_crashing(srv, spec):
     r = create_volume(srv, field={"spec": spec})
