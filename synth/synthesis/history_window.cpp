@@ -40,7 +40,23 @@ HistoryWindow::Resolved HistoryWindow::resolve(const Voxel& p) const {
   return r;
 }
 
-NeighbourSlots::NeighbourSlots(const LevelSchedule& schedule, const HistoryWindow::Resolved& window, const Voxel& p) {
+NeighbourSlots::StepTable NeighbourSlots::StepTable::make(const LevelSchedule& schedule,
+                                                         const HistoryWindow::Resolved& window) {
+  StepTable t;
+  const int s = schedule.subpass_size();
+  for (int m = 0; m < 128; ++m) {
+    if (s == 1 && m >= 16) break;  // one update class: the parity bits are never set
+    int v = window.latest;
+    for (int b = 0; b < window.count; ++b)
+      if (m & (1 << b)) v = std::min(v, window.barrier_version[size_t(b)]);
+    t.slot[size_t(m)] = schedule.slot_of_class(m >> 4, v);
+  }
+  return t;
+}
+
+NeighbourSlots::NeighbourSlots(const StepTable& table, const LevelSchedule& schedule,
+                               const HistoryWindow::Resolved& window, const Voxel& p)
+    : table_(&table) {
   const int s = schedule.subpass_size();
   const int centre[3] = {p.x, p.y, p.z};
   for (int a = 0; a < 3; ++a)
@@ -54,13 +70,6 @@ NeighbourSlots::NeighbourSlots(const LevelSchedule& schedule, const HistoryWindo
       }
       axis_[size_t(a)][size_t(o + kReach)] = bits;
     }
-  for (int m = 0; m < 128; ++m) {
-    if (s == 1 && m >= 16) break;  // one update class: the parity bits are never set
-    int v = window.latest;
-    for (int b = 0; b < window.count; ++b)
-      if (m & (1 << b)) v = std::min(v, window.barrier_version[size_t(b)]);
-    slot_[size_t(m)] = schedule.slot_of_class(m >> 4, v);
-  }
 }
 
 std::vector<int> HistoryWindow::materialize(const Voxel& p, int d) const {

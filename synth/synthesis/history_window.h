@@ -125,20 +125,29 @@ class LevelSchedule {
 // The storage slot of every neighbour p + o of one voxel p, |o| <= kReach on each axis, for
 // one step: slot(o) == schedule.slot(p + o, window.version_of(p + o)). Being outside a
 // barrier's cell and the update class both decide axis by axis, so a lookup is three small
-// table reads or-ed together and one table read; built once per corrected voxel.
+// table reads or-ed together and one read of the step's table; built once per corrected voxel.
 class NeighbourSlots {
  public:
   static constexpr int kReach = 8;
-  NeighbourSlots(const LevelSchedule& schedule, const HistoryWindow::Resolved& window, const Voxel& p);
+  // The slot per (update class, outside-barrier mask) of one step. It depends on the window's
+  // versions only, which are the same for every voxel of the step (resolve() moves the cells,
+  // not the versions), so it is built once per step.
+  struct StepTable {
+    std::array<int, 128> slot{};  // by (class << 4) | outside-barrier mask
+    static StepTable make(const LevelSchedule& schedule, const HistoryWindow::Resolved& window);
+  };
+  // `table` must be StepTable::make of the same step and outlive this object.
+  NeighbourSlots(const StepTable& table, const LevelSchedule& schedule, const HistoryWindow::Resolved& window,
+                 const Voxel& p);
   int slot(int dx, int dy, int dz) const {
-    return slot_[size_t(axis_[0][size_t(dx + kReach)] | axis_[1][size_t(dy + kReach)] | axis_[2][size_t(dz + kReach)])];
+    return table_->slot[size_t(axis_[0][size_t(dx + kReach)] | axis_[1][size_t(dy + kReach)] | axis_[2][size_t(dz + kReach)])];
   }
 
  private:
   // Per axis and offset: bit b (0-3) when outside barrier b's cell on that axis, bit 4 + axis
   // for the odd coordinate that makes up the update class.
   std::array<std::array<uint8_t, 2 * kReach + 1>, 3> axis_{};
-  std::array<int, 128> slot_{};  // by (class << 4) | outside-barrier mask
+  const StepTable* table_;
 };
 
 }  // namespace solidtex

@@ -83,7 +83,9 @@ TEST(NeighbourSlots, EqualTheSchedulesSlotOfTheWindowsVersionForEveryOffset) {
       for (const Voxel p : {Voxel{0, 0, 0}, Voxel{5, -1, 7}, Voxel{-13, 22, 3}, Voxel{11, 6, -6}})
         for (const CorrectionStep& step : sch.steps()) {
           const HistoryWindow::Resolved w = step.window.resolve(p);
-          const NeighbourSlots slots(sch, w, p);
+          // The step's table from another voxel's window: the versions do not depend on p.
+          const auto table = NeighbourSlots::StepTable::make(sch, step.window.resolve({100, -50, 7}));
+          const NeighbourSlots slots(table, sch, w, p);
           const int r = NeighbourSlots::kReach;
           int first = -1;
           for (int dz = -r; dz <= r; ++dz)

@@ -9,6 +9,7 @@
 #include <map>
 #include <mutex>
 #include <string>
+#include <type_traits>
 
 #include "synthesis/correction.h"
 #include "synthesis/cost_model.h"
@@ -96,31 +97,27 @@ struct StoreReader {
   SetChecks& checks;
   std::atomic<bool>& outside_store;
 
-  int slot_of(int dx, int dy, int dz, Voxel& q) const {
-    q = {p.x + dx, p.y + dy, p.z + dz};
-    return near_reaches ? slots.slot(dx, dy, dz) : sch.slot(q, window.version_of(q));
-  }
-  const StateColor& color(int dx, int dy, int dz) const {
-    Voxel q;
-    const int slot = slot_of(dx, dy, dz, q);
-    if (!checks.read(store, q, slot)) return dummy_state().color;
-    const StateColor* c = near_reaches ? near.color(dx, dy, dz, slot) : (store.has(q) ? &store.color(q, slot) : nullptr);
-    if (!c) {
-      outside_store = true;
+  const StateColor& color(int dx, int dy, int dz) const { return read<StateColor>(dx, dy, dz); }
+  const CoordinateTriple& triple(int dx, int dy, int dz) const { return read<CoordinateTriple>(dx, dy, dz); }
+
+ private:
+  template <class T>
+  const T& read(int dx, int dy, int dz) const {
+    const Voxel q{p.x + dx, p.y + dy, p.z + dz};
+    const int slot = near_reaches ? slots.slot(dx, dy, dz) : sch.slot(q, window.version_of(q));
+    const T* v = nullptr;
+    if (checks.read(store, q, slot)) {
+      if constexpr (std::is_same_v<T, StateColor>)
+        v = near_reaches ? near.color(dx, dy, dz, slot) : (store.has(q) ? &store.color(q, slot) : nullptr);
+      else
+        v = near_reaches ? near.triple(dx, dy, dz, slot) : (store.has(q) ? &store.triple(q, slot) : nullptr);
+      if (!v) outside_store = true;
+    }
+    if (v) return *v;
+    if constexpr (std::is_same_v<T, StateColor>)
       return dummy_state().color;
-    }
-    return *c;
-  }
-  const CoordinateTriple& triple(int dx, int dy, int dz) const {
-    Voxel q;
-    const int slot = slot_of(dx, dy, dz, q);
-    if (!checks.read(store, q, slot)) return dummy_state().triple;
-    const CoordinateTriple* t = near_reaches ? near.triple(dx, dy, dz, slot) : (store.has(q) ? &store.triple(q, slot) : nullptr);
-    if (!t) {
-      outside_store = true;
+    else
       return dummy_state().triple;
-    }
-    return *t;
   }
 };
 
@@ -236,6 +233,7 @@ Status correct_level(const LevelPass& pass, const LevelDependencies& dep, LevelS
     if (poller.poll(percent)) return Status(StatusCode::kCancelled, "synthesis cancelled");
     const CorrectionStep& step = sch.steps()[size_t(v - 1)];
     std::atomic<bool> outside_store{false};
+    const NeighbourSlots::StepTable slot_table = NeighbourSlots::StepTable::make(sch, step.window.resolve(Voxel{}));
     std::vector<Voxel> updates;
     for (const Voxel& p : dep.needed[size_t(v)].to_vector())
       if (step.updates.contains(p)) updates.push_back(p);
@@ -248,7 +246,7 @@ Status correct_level(const LevelPass& pass, const LevelDependencies& dep, LevelS
         const ReadStencil& st = frames.stencil(l, p, local);
         const HistoryWindow::Resolved window = step.window.resolve(p);
         const LevelStore::Neighborhood near(store, p);
-        const NeighbourSlots slots(sch, window, p);
+        const NeighbourSlots slots(slot_table, sch, window, p);
         StoreReader read{store, sch, window, near, slots, p, near_reaches, checks, outside_store};
         const int out = sch.slot(p, v);
         const CoordinateTriple t = correct_voxel(ctx, st, read, scratch);
