@@ -6,7 +6,7 @@ Embark's 2D texture-synthesis on the same exemplar and size.
                   [--typicality T]   (synthesis' typicality weight; default: the CLI's default)
 
 For every exemplar in ../shared/data/exemplars (wood_grain and wood_planks analysed with
---grain x, the rest with defaults): z, y and x cuts and one oblique cut of SIZE^2 through the
+--grain x, the rest with defaults, whose --grain auto gives stripes_dunes grain x): z, y and x cuts and one oblique cut of SIZE^2 through the
 origin, scored with ../shared/tools/texmetric.py (swd, coverage, energy, sharp; read its header:
 energy alone rewards blur). Embark 2D (../shared/tools/embark-ref, built into BUILD/embark-ref
 with cargo on first use) synthesizes SIZE^2 from the same exemplar. Prints one JSON document
@@ -98,7 +98,7 @@ def main() -> int:
         for ex in exemplars:
             name = ex.stem
             grain = ["--grain", "x"] if name in GRAIN_X else []
-            table = (args.table_cache or tmp) / f"{name}{'_grain_x' if grain else ''}.stx"
+            table = (args.table_cache or tmp) / f"{name}_grain_{'x' if grain else 'auto'}.stx"
             if not (args.table_cache and table.exists()):
                 table.parent.mkdir(parents=True, exist_ok=True)
                 run([solidtex, "analyze", ex, *grain, "-o", table])

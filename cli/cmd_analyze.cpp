@@ -1,8 +1,9 @@
 // solidtex analyze IMAGE [--yz IMAGE --zx IMAGE] [--mask IMAGE [--mask-yz IMAGE --mask-zx IMAGE]]
 //   [--mask-weight W] [--levels 4] [--neighborhood 9] [--candidates 12] [--pca-dims 20]
-//   [--seed S] [--threads T] -o TABLE.stx [--json]
+//   [--seed S] [--threads T] [--grain auto|none|x|y] -o TABLE.stx [--json]
 #include <nlohmann/json.hpp>
 
+#include <cstdio>
 #include <filesystem>
 #include <iostream>
 
@@ -54,9 +55,12 @@ Status run_analyze(const std::vector<std::string>& argv) {
   SOLIDTEX_ASSIGN_OR_RETURN(in.mask_xy, optional_image(args, "--mask", "mask"));
   SOLIDTEX_ASSIGN_OR_RETURN(in.mask_yz, optional_image(args, "--mask-yz", "mask_yz"));
   SOLIDTEX_ASSIGN_OR_RETURN(in.mask_zx, optional_image(args, "--mask-zx", "mask_zx"));
-  if (auto grain = args.get("--grain")) {
-    SOLIDTEX_RETURN_IF_ERROR(apply_grain_layout(*grain, in, params.suggested_plane_weights).with_context("--grain"));
-  }
+  const std::string grain = args.get("--grain").value_or("auto");
+  Result<std::string> layout = apply_grain_layout(grain, in, params.suggested_plane_weights);
+  if (!layout) return layout.status().with_context("--grain");
+  if (grain == "auto" && !layout->empty())
+    std::fprintf(stderr, "grain: the exemplar is striped along %s; analysing with --grain %s (--grain none to keep it isotropic)\n",
+                 layout->c_str(), layout->c_str());
   SOLIDTEX_ASSIGN_OR_RETURN(double mw, args.get_double("--mask-weight", 1.0, 0.0, 10.0));
   in.mask_weight = float(mw);
   SOLIDTEX_ASSIGN_OR_RETURN(ExemplarSet exemplars, ExemplarSet::create(std::move(in)));
@@ -72,6 +76,7 @@ Status run_analyze(const std::vector<std::string>& argv) {
     j["seconds"] = result.seconds;
     j["table_bytes"] = bytes.size();
     j["shared_exemplar"] = exemplars.shared();
+    j["grain"] = *layout;
     j["channels"] = exemplars.channels();
     nlohmann::json levels = nlohmann::json::array();
     for (const LevelReport& r : result.levels)

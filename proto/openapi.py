@@ -87,7 +87,7 @@ analysis_params = [
     qp("seed", "Seeds the k-NN trees.", integer(0, MAX_SEED, default=1)),
     {**qlist("plane_weights", "Suggested plane weights A,B,C (xy, yz, zx) stored with the table, each in [0, 1], not all 0 (one at least 1e-6).", number(0, 1), 3),
      "schema": {"type": "array", "items": number(0, 1), "minItems": 3, "maxItems": 3, "contains": {"minimum": 1e-6}}},
-    qp("grain", "'x': the exemplar's stripes run along its x axis and the solid's grain along world x: xy = E, zx = E transposed, yz = E with suggested weight 0.1 (as `solidtex analyze --grain x`); not with yz/zx parts.", {"type": "string", "enum": ["x"]}),
+    qp("grain", "Grain layout. 'x': the exemplar's stripes run along its x axis and the solid's grain along world x: xy = E, zx = E transposed, yz = E with suggested weight 0.1 (as `solidtex analyze --grain x`). 'y': stripes along its y axis, grain along world y: xy = E, yz = E transposed, zx = E with weight 0.1. 'auto' (default): 'x' or 'y' when the exemplar is strongly striped along that axis (structure-tensor coherence >= 0.6, within 20 degrees), isotropic otherwise and with yz/zx parts. 'none': isotropic. The exemplar's `grain` reports the layout applied ('', 'x' or 'y'). 'x' and 'y' not with yz/zx parts.", {"type": "string", "enum": ["auto", "none", "x", "y"], "default": "auto"}),
     qp("mask_weight", "Weight of the feature-mask channel relative to color.", number(0, 10, default=1)),
 ]
 

@@ -284,7 +284,7 @@ HttpResponse Api::upload_exemplar(const HttpRequest& r) {
       SOLIDTEX_RETURN_IF_ERROR(check_plane_weights(w, "plane_weights"));
       up.params.suggested_plane_weights = {float(w[0]), float(w[1]), float(w[2])};
     }
-    up.grain = q.get("grain").value_or("");
+    up.grain = q.get("grain").value_or("auto");
     SOLIDTEX_ASSIGN_OR_RETURN(double mw, q.get_double("mask_weight", 1.0, 0.0, 10.0));
     up.mask_weight = float(mw);
     if (r.multipart) {

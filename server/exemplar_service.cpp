@@ -67,7 +67,7 @@ struct ExemplarService::Impl {
   // `max_bytes` > 0: the analysis cost limit, checked as the images are decoded (uploads).
   Result<ExemplarSet> build_set(const std::vector<std::pair<std::string, std::vector<uint8_t>>>& parts,
                                 const std::string& grain, float mask_weight, AnalysisParams& params,
-                                int64_t max_bytes = 0) const {
+                                int64_t max_bytes = 0, std::string* applied_grain = nullptr) const {
     ExemplarInputs in;
     bool have_xy = false, have_mask = false;
     for (const auto& [name, bytes] : parts) {
@@ -113,7 +113,8 @@ struct ExemplarService::Impl {
       else return Status(StatusCode::kInvalidArgument, "unknown part (expected xy, yz, zx, mask, mask_yz, mask_zx)", name);
     }
     if (!have_xy) return Status(StatusCode::kInvalidArgument, "an exemplar image is required (part 'xy' or 'image')", "xy");
-    SOLIDTEX_RETURN_IF_ERROR(apply_grain_layout(grain, in, params.suggested_plane_weights));
+    SOLIDTEX_ASSIGN_OR_RETURN(std::string layout, apply_grain_layout(grain, in, params.suggested_plane_weights));
+    if (applied_grain) *applied_grain = layout;
     in.mask_weight = mask_weight;
     auto set = ExemplarSet::create(std::move(in));
     if (!set) return Status(StatusCode::kUnprocessable, set.status().message(), set.status().field());
@@ -344,8 +345,10 @@ Result<json> ExemplarService::upload(ExemplarUpload up) {
   AnalysisParams params = up.params;
   params.search_k = std::max(params.search_k, params.candidates / 2 + 1);
   SOLIDTEX_RETURN_IF_ERROR(params.validate());
-  SOLIDTEX_ASSIGN_OR_RETURN(ExemplarSet set,
-                            impl_->build_set(up.parts, up.grain, up.mask_weight, params, impl_->config.max_request_bytes));
+  // "auto" is resolved here, once: the stored grain is the layout applied ("", "x" or "y").
+  std::string grain;
+  SOLIDTEX_ASSIGN_OR_RETURN(ExemplarSet set, impl_->build_set(up.parts, up.grain, up.mask_weight, params,
+                                                               impl_->config.max_request_bytes, &grain));
   if (const int64_t bytes = estimate_analysis_bytes(set, params); bytes > impl_->config.max_request_bytes)
     return Status(StatusCode::kUnprocessable,
                   "analysing this exemplar needs about " + std::to_string(bytes >> 20) + " MB; the limit is " +
@@ -365,7 +368,7 @@ Result<json> ExemplarService::upload(ExemplarUpload up) {
   e.meta = {{"id", id},
             {"name", up.name},
             {"params", to_json(params)},
-            {"grain", up.grain},
+            {"grain", grain},
             {"mask_weight", up.mask_weight},
             {"parts", parts},
             {"planes", set.shared() ? 1 : 3},

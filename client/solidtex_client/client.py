@@ -289,7 +289,7 @@ class Client:
         ``mask_zx`` (feature masks of the three planes).
         ``analysis_params`` go in the query: ``name``, ``levels``, ``neighborhood`` (odd
         template size in pixels), ``candidates``, ``pca_dims``, ``seed``, ``plane_weights``
-        (a 3-sequence or ``"a,b,c"``), ``grain`` (``"x"``), ``mask_weight``. Returns ``{"exemplar": ..., "job": ...}``.
+        (a 3-sequence or ``"a,b,c"``), ``grain`` (``"auto"`` by default, ``"none"``, ``"x"``, ``"y"``), ``mask_weight``. Returns ``{"exemplar": ..., "job": ...}``.
         """
         params = {k: v for k, v in analysis_params.items() if v is not None}
         xy = image_bytes(image)

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <string>
 
+#include "analysis/orientation.h"
+
 namespace solidtex {
 namespace {
 
@@ -96,19 +98,28 @@ Result<ExemplarSet> ExemplarSet::from_matching_images(std::array<std::shared_ptr
   return set;
 }
 
-Status apply_grain_layout(const std::string& grain, ExemplarInputs& in,
-                          std::array<float, 3>& suggested_plane_weights) {
-  if (grain.empty()) return Status::ok();
-  if (grain != "x") return Status(StatusCode::kInvalidArgument, "only 'x' is supported", "grain");
-  if (in.yz || in.zx) return Status(StatusCode::kInvalidArgument, "cannot be combined with yz/zx exemplars", "grain");
-  in.yz = in.xy;
-  in.zx = transposed(in.xy);
-  if (in.mask_xy) {
-    in.mask_yz = in.mask_xy;
-    in.mask_zx = transposed(*in.mask_xy);
+Result<std::string> apply_grain_layout(const std::string& grain, ExemplarInputs& in,
+                                       std::array<float, 3>& suggested_plane_weights) {
+  if (grain.empty() || grain == "none") return std::string();
+  std::string layout = grain;
+  if (grain == "auto") {
+    if (in.yz || in.zx) return std::string();
+    layout = auto_grain_layout(estimate_stripe_orientation(in.xy));
+    if (layout.empty()) return layout;
+  } else if (grain != "x" && grain != "y") {
+    return Status(StatusCode::kInvalidArgument, "unknown grain '" + grain + "' (auto, none, x, y)", "grain");
   }
-  suggested_plane_weights = {1.f, 0.1f, 1.f};
-  return Status::ok();
+  if (in.yz || in.zx) return Status(StatusCode::kInvalidArgument, "cannot be combined with yz/zx exemplars", "grain");
+  // The plane that holds both of the grain's cross axes shows end grain: E, down-weighted.
+  const bool along_x = layout == "x";
+  (along_x ? in.zx : in.yz) = transposed(in.xy);
+  (along_x ? in.yz : in.zx) = in.xy;
+  if (in.mask_xy) {
+    (along_x ? in.mask_zx : in.mask_yz) = transposed(*in.mask_xy);
+    (along_x ? in.mask_yz : in.mask_zx) = in.mask_xy;
+  }
+  suggested_plane_weights = along_x ? std::array<float, 3>{1.f, 0.1f, 1.f} : std::array<float, 3>{1.f, 1.f, 0.1f};
+  return layout;
 }
 
 }  // namespace solidtex

@@ -33,9 +33,14 @@ struct ExemplarInputs {
 // "x": an anisotropic exemplar whose stripes run along its x axis, for a solid whose grain
 // runs along world x: xy = E, zx = E transposed (consistent in 3D), yz = E (the end grain
 // the exemplar cannot show, so the returned suggested plane weights give it 0.1).
-// Fails when the inputs already have yz/zx. "" leaves everything unchanged.
-Status apply_grain_layout(const std::string& grain, ExemplarInputs& inputs,
-                          std::array<float, 3>& suggested_plane_weights);
+// "y": stripes along the exemplar's y axis, grain along world y: xy = E, yz = E transposed,
+// zx = E (end grain, weight 0.1).
+// "auto" (the default): "x" or "y" when the exemplar is strongly striped along that axis
+// (orientation.h: auto_grain_layout), isotropic otherwise, and isotropic whenever yz/zx
+// are given. "" and "none": isotropic, every plane the same exemplar.
+// Returns the layout applied: "", "x" or "y". Fails for an explicit layout with yz/zx.
+Result<std::string> apply_grain_layout(const std::string& grain, ExemplarInputs& inputs,
+                                       std::array<float, 3>& suggested_plane_weights);
 
 class ExemplarSet {
  public:

@@ -8,31 +8,12 @@
 #include <vector>
 
 #include "analysis/knn_index.h"
+#include "analysis/orientation.h"
 #include "analysis/neighborhood.h"
 
 namespace solidtex {
 
-double dominant_orientation_degrees(const ImageF& img) {
-  auto lum = [&](int x, int y) {
-    const float* p = img.at(x, y);
-    return img.channels >= 3 ? 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2] : double(p[0]);
-  };
-  double jxx = 0, jyy = 0, jxy = 0;
-  for (int y = 1; y + 1 < img.height; ++y)
-    for (int x = 1; x + 1 < img.width; ++x) {
-      const double gx = 0.5 * (lum(x + 1, y) - lum(x - 1, y));
-      const double gy = 0.5 * (lum(x, y + 1) - lum(x, y - 1));
-      jxx += gx * gx;
-      jyy += gy * gy;
-      jxy += gx * gy;
-    }
-  // Gradient direction, then the stripes run perpendicular to it.
-  double gradient = 0.5 * std::atan2(2 * jxy, jxx - jyy) * 180.0 / M_PI;
-  double stripes = gradient + 90.0;
-  while (stripes > 90.0) stripes -= 180.0;
-  while (stripes <= -90.0) stripes += 180.0;
-  return stripes;
-}
+double dominant_orientation_degrees(const ImageF& img) { return estimate_stripe_orientation(img).degrees; }
 
 double dominant_period_x(const ImageF& img) {
   const int w = img.width;

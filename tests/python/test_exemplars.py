@@ -1,7 +1,7 @@
 """Exemplar upload, background analysis, table download and bit identity with the CLI."""
 import numpy as np
 
-from support import ANALYSIS, ANALYSIS_CLI, file_pixels, post_bytes, run_cli
+from support import ANALYSIS, ANALYSIS_CLI, file_pixels, post_bytes, run_cli, upload_ready
 from solidtex_client import encode_png
 
 
@@ -29,7 +29,9 @@ def test_upload_analyse_download_matches_cli(shared, exemplars, cli_table):
     assert got["id"] == ex["id"]
     assert got["state"] == "ready"
     assert got["name"] == "wood2"
-    assert got["planes"] == 1
+    # the procedural wood is strongly striped along x: grain=auto (the default) lays it out as grain x
+    assert got["grain"] == "x"
+    assert got["planes"] == 3
     assert (got["width"], got["height"]) == (64, 64)
     assert got["has_mask"] is False
     assert got["job_id"] == job["id"]
@@ -46,6 +48,23 @@ def test_upload_analyse_download_matches_cli(shared, exemplars, cli_table):
     assert table == cli_table.read_bytes(), "service table differs from `solidtex analyze`"
     # the shared fixture's upload of the same image gives the same table too
     assert shared.table == table
+
+
+def test_grain_auto_none_and_y_layouts(shared, exemplars):
+    """grain=auto gives striped exemplars a grain layout and leaves isotropic ones alone; none
+    keeps a striped one isotropic; y takes stripes along the image's y axis; the stored grain is
+    the layout applied. Unknown layouts are a 400 naming grain."""
+    c = shared.client
+    noise = upload_ready(c, exemplars["noise"])
+    assert (noise["grain"], noise["planes"]) == ("", 1), noise
+    none = upload_ready(c, exemplars["wood"], grain="none")
+    assert (none["grain"], none["planes"]) == ("", 1), none
+    upright = np.ascontiguousarray(file_pixels(exemplars["wood"]).transpose(1, 0, 2))
+    auto_y = upload_ready(c, upright)
+    assert (auto_y["grain"], auto_y["planes"]) == ("y", 3), auto_y
+    r = post_bytes(shared.server.url + "/v1/exemplars", exemplars["wood"].read_bytes(), params={**ANALYSIS, "grain": "z"})
+    assert r.status_code == 400, r.text
+    assert r.json()["error"]["field"] == "grain", r.text
 
 
 def test_three_planes_multipart_matches_cli(shared, exemplars, tmp_path):

@@ -73,7 +73,8 @@ def budget(binary, exemplars, tmp_path_factory):
         s = factory.start("--threads", "2", "--volume-state-mb", BUDGET_MB, "--idle-evict-s", "0")
         s.volumes = {}
         for kind in ("wood", "stripes", "bricks", "noise"):
-            ex = upload_ready(s.client, exemplars[kind])
+            # isotropic layouts (one table plane), so that two volumes' state fits the budget
+            ex = upload_ready(s.client, exemplars[kind], grain="none")
             s.volumes[kind] = s.client.create_volume(exemplar=ex["id"], seed=3)["id"]
         yield s
     finally:
