@@ -144,7 +144,7 @@ S = {
      "exemplars": {"type": "array", "items": {"type": "string"}}, "label": {"type": "string"},
      "field": {"type": "object", "description": "Where the field came from: {\"kind\": \"identity\"}, {\"kind\": \"spec\", \"spec\"} or {\"kind\": \"stored\", \"id\", \"revision\"} (the volume keeps its own copy of that revision).", "properties": {"kind": {"type": "string", "enum": ["identity", "spec", "stored"]}, "spec": {"type": "string"}, "id": {"type": "string"}, "revision": {"type": "integer"}}},
      "field_description": {"type": "string", "description": "Human-readable description of the field, e.g. 'identity' or 'quat:0.92,0,0,0.38'."},
-     "seed": {"type": "integer"}, "params": {"type": "object", "description": "The synthesis params as given, with the appearance-changing defaults pinned to the values it was created with (`typicality`, `passes`; volumes stored before they were pinned come back with typicality 0 and 2 passes, what their voxels were made with), so later defaults never change a stored volume."}}},
+     "seed": {"type": "integer"}, "params": {"type": "object", "description": "The synthesis params as given, with the appearance-changing defaults pinned to the values it was created with (`typicality`, `passes`, `init`; volumes stored before they were pinned come back with typicality 0, 2 passes and slab init, what their voxels were made with), so later defaults never change a stored volume."}}},
  "Cut": {"type": "object", "additionalProperties": False, "required": ["origin", "u", "v", "size"],
      "description": f"The far corner origin + W*u + H*v must lie within +-2^28 too (else 400); W*H at most --max-voxels (else 422).",
      "properties": {

@@ -30,7 +30,7 @@ TEST(ApiJson, WireFormatOfTheDefaults) {
             R"({"candidates":12,"knn_checks":192,"levels":4,"neighborhood":9,"pca_dims":20,"search_k":24,"seed":1,)"
             R"("suggested_plane_weights":[1.0,1.0,1.0]})");
   EXPECT_EQ(to_json(SynthesisParams{}).dump(),
-            R"({"cell_size":12,"coarse_passes":3,"init_subpart":32,"matcher":"paper","passes":1,)"
+            R"({"cell_size":12,"coarse_passes":3,"init":"scatter","init_subpart":32,"matcher":"paper","passes":1,)"
             R"("plane_weights":[1.0,1.0,1.0],"scheme":"dual-grid","subpass_size":2,"trilinear_levels":2,"typicality":0.5})");
 }
 
@@ -55,6 +55,7 @@ TEST(ApiJson, EveryKeyReadsBackWhatItWrites) {
   s.passes = 3;
   s.subpass_size = 1;
   s.cell_size = 16;
+  s.init = Init::kSlab;
   s.init_subpart = 64;
   s.trilinear_levels = 0;
   s.plane_weights = {0.5f, 1.f, 0.f};
@@ -102,7 +103,8 @@ TEST(ApiJson, ErrorsNameTheField) {
       {{{"plane_weights", {1, 1}}}, "params.plane_weights", "must be 3 numbers"},
       {{{"plane_weights", {1, 2, 1}}}, "params.plane_weights", "must be in [0.000000, 1.000000]"},
       {{{"plane_weights", {0, 0, 0}}}, "params.plane_weights", "must not all be zero"},  // validate()
-      {{{"init_subpart", 9}}, "params.init_subpart", "must be even"},                    // validate()
+      {{{"init_subpart", 9}}, "params.init_subpart", "must be even"},
+      {{{"init", "random"}}, "params.init", "unknown init 'random'"},                    // validate()
       {{{"typicality", 5}}, "params.typicality", "must be in [0.000000, 4.000000]"},
       {{{"typicality", "high"}}, "params.typicality", "must be a number"},
   };

@@ -476,13 +476,13 @@ bool pin_params(json& spec, const json& values) {
 }
 
 // The defaults a new volume pins (SynthesisParams), and the ones volumes stored before each
-// was pinned were synthesized with: typicality did not exist (0), and fine levels ran two
-// correction passes.
+// was pinned were synthesized with: typicality did not exist (0), fine levels ran two
+// correction passes, and the coarsest level started from slabs.
 json current_defaults() {
   const SynthesisParams d;
-  return {{"typicality", d.typicality}, {"passes", d.passes}};
+  return {{"typicality", d.typicality}, {"passes", d.passes}, {"init", init_name(d.init)}};
 }
-json legacy_defaults() { return {{"typicality", 0.0}, {"passes", 2}}; }
+json legacy_defaults() { return {{"typicality", 0.0}, {"passes", 2}, {"init", "slab"}}; }
 
 }  // namespace
 

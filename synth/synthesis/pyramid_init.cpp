@@ -12,7 +12,27 @@ std::array<const ImageF*, kNumPlanes> exemplar_planes(const Table& table) {
 }
 }  // namespace
 
+namespace {
+// The first (best by crossbar error) candidate triple of an xy pixel; the pixel itself in
+// every plane when it has none.
+CoordinateTriple first_candidate(const Table& table, ExemplarPixel pixel) {
+  const auto list = table.level(PyramidLevel{0}).candidates.planes[0].at(pixel);
+  if (!list.empty()) return list[0];
+  CoordinateTriple t;
+  t.at = {pixel, pixel, pixel};
+  return t;
+}
+
+CoordinateTriple scatter_triple(const Table& table, const Voxel& v, uint32_t seed) {
+  const ImageF& xy = table.exemplars().plane(Plane::kXY);
+  const uint64_t hsh = hash_u64(uint64_t(int64_t(v.x)), uint64_t(int64_t(v.y)), uint64_t(int64_t(v.z)),
+                                uint64_t(seed) << 32 ^ 0x5ca7ull);
+  return first_candidate(table, {int(hsh % uint64_t(xy.width)), int((hsh >> 32) % uint64_t(xy.height))});
+}
+}  // namespace
+
 CoordinateTriple init_triple(const Table& table, const Voxel& v, const Rot3& r, const SynthesisParams& params) {
+  if (params.init == Init::kScatter) return scatter_triple(table, v, params.seed);
   const PyramidLevel coarsest{0};
   const int h = table.spacing(coarsest);
   const int n = table.params().neighborhood;
@@ -31,13 +51,7 @@ CoordinateTriple init_triple(const Table& table, const Voxel& v, const Rot3& r, 
                                 params.seed, 0x51ab);
   const int ox = int(hsh % uint64_t(xy.width)), oy = int((hsh >> 32) % uint64_t(xy.height));
   const ExemplarPixel pixel{ImageF::wrap(h * wx + ox, xy.width), ImageF::wrap(h * wy + oy, xy.height)};
-  const auto list = table.level(coarsest).candidates.planes[0].at(pixel);
-  CoordinateTriple base;
-  if (list.empty()) {
-    base.at = {pixel, pixel, pixel};
-  } else {
-    base = list[0];
-  }
+  const CoordinateTriple base = first_candidate(table, pixel);
   const int step[3] = {0, 0, h * dz};
   return shift_triple(base, step, exemplar_planes(table));
 }

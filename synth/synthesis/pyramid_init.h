@@ -8,6 +8,10 @@
 // cut into K^3 subparts; a voxel v in the subpart with centre c reads the tiled volume at
 // w = lround(R^T (v - c)) + c, so the slab pattern turns with the local frame about c and
 // rotation-induced distortion stays bounded by K (Fig. 4).
+// Scatter initialisation (SynthesisParams::init, the default): voxel w takes the first
+// candidate triple of the exemplar pixel hash(w, seed); neither the field nor K matter, since
+// a pattern of independent draws looks the same turned. The coarse passes then grow
+// coherent patches from it, in every direction alike.
 //
 // Upsampling: child v of parent P = floor(v/2) gets T(P) + R_P^T * (h_l * (v mod 2)), each
 // plane's 2D offset rounded to the nearest pixel (std::lround).

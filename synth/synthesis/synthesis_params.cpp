@@ -15,6 +15,14 @@ Result<Scheme> parse_scheme(const std::string& name) {
   return Status(StatusCode::kInvalidArgument, "unknown scheme '" + name + "' (plain, subpass, grid, dual-grid)", "scheme");
 }
 
+Result<Init> parse_init(const std::string& name) {
+  if (name == "slab") return Init::kSlab;
+  if (name == "scatter") return Init::kScatter;
+  return Status(StatusCode::kInvalidArgument, "unknown init '" + name + "' (slab, scatter)", "init");
+}
+
+const char* init_name(Init i) { return i == Init::kSlab ? "slab" : "scatter"; }
+
 Result<Matcher> parse_matcher(const std::string& name) {
   if (name == "paper") return Matcher::kPaper;
   if (name == "coherent") return Matcher::kCoherent;

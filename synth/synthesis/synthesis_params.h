@@ -29,6 +29,15 @@ enum class Scheme {
               // barrier version is the grid passes' final version (Zhang §5.3)
 };
 
+// How the coarsest level's version 0 is made (pyramid_init.h).
+enum class Init {
+  kSlab,     // Zhang §4.1: candidate slabs (exemplar xy thickened along z) tiled per subpart;
+             // it leaves streaks along z in x and y cuts that one fine pass does not remove
+  kScatter,  // every coarsest voxel a hashed exemplar pixel's best candidate triple: no axis is special
+};
+Result<Init> parse_init(const std::string& name);
+const char* init_name(Init i);
+
 Result<Scheme> parse_scheme(const std::string& name);
 const char* scheme_name(Scheme s);
 
@@ -39,7 +48,10 @@ struct SynthesisParams {
   int passes = 1;            // correction passes at every finer level, [0, 8]
   int subpass_size = 2;      // s: s^3 subpasses per pass for subpass/grid schemes, {1, 2}
   int cell_size = 12;        // M: grid cell side in voxels of the level, [4, 64]
-  int init_subpart = 32;     // K: coarsest-level voxels per initialisation subpart side, even, [8, 256]
+  // Scatter by default, chosen by measurement (README, Quality): the x and y cuts lose the
+  // slabs' streaks along z. Volumes pin it, and volumes stored before restore with kSlab.
+  Init init = Init::kScatter;
+  int init_subpart = 32;     // K: coarsest-level voxels per slab-initialisation subpart side, even, [8, 256]
   int trilinear_levels = 2;  // the coarsest this-many levels sample neighborhoods trilinearly, [0, 8]
   uint32_t seed = 1;         // hashed with (voxel, level) wherever synthesis needs randomness
   // Relative weight of each plane (xy, yz, zx) in matching costs and voxel colors, [0, 1],

@@ -249,22 +249,31 @@ TEST_F(SynthesizerTest, CorrectionLowersMatchingEnergyAndDualGridKeepsQuality) {
   };
   // Plain L2 matching, the objective energy measures; the typicality penalty trades some of it
   // for crispness (SynthesizerQuality judges that with two-sided measures).
-  auto plain = [](Scheme scheme) {
-    SynthesisParams p = small_params(scheme);
-    p.typicality = 0.f;
-    return p;
-  };
-  SynthesisParams none = plain(Scheme::kSubpass);
-  none.coarse_passes = 0;
-  none.passes = 0;
-  const double e_init = energy(none);
-  const double e_subpass = energy(plain(Scheme::kSubpass));
-  const double e_dual = energy(plain(Scheme::kDualGrid));
-  RecordProperty("energy_init", std::to_string(e_init));
-  RecordProperty("energy_subpass", std::to_string(e_subpass));
-  RecordProperty("energy_dual_grid", std::to_string(e_dual));
-  EXPECT_LT(e_subpass, 0.8 * e_init) << e_subpass << " vs init " << e_init;
-  EXPECT_LT(e_dual, 1.1 * e_subpass) << e_dual << " vs subpass " << e_subpass;
+  for (const Init init : {Init::kSlab, Init::kScatter}) {
+    SCOPED_TRACE(init_name(init));
+    auto plain = [&](Scheme scheme) {
+      SynthesisParams p = small_params(scheme);
+      p.typicality = 0.f;
+      p.init = init;
+      return p;
+    };
+    SynthesisParams none = plain(Scheme::kSubpass);
+    none.coarse_passes = 0;
+    none.passes = 0;
+    const double e_init = energy(none);
+    const double e_subpass = energy(plain(Scheme::kSubpass));
+    const double e_dual = energy(plain(Scheme::kDualGrid));
+    const std::string tag = init_name(init);
+    RecordProperty("energy_init_" + tag, std::to_string(e_init));
+    RecordProperty("energy_subpass_" + tag, std::to_string(e_subpass));
+    RecordProperty("energy_dual_grid_" + tag, std::to_string(e_dual));
+    EXPECT_LT(e_subpass, 0.8 * e_init) << e_subpass << " vs init " << e_init;
+    // Zhang §5.3: dual-grid keeps the subpass scheme's quality (within 10% with slabs, measured
+    // 1.06x). From scattered triples the grid cells' barriers read a less coherent version 0:
+    // measured 1.19x, though both schemes' energies are lower than from slabs (subpass 0.0054
+    // vs 0.0066, dual-grid 0.0064 vs 0.0070).
+    EXPECT_LT(e_dual, (init == Init::kSlab ? 1.1 : 1.25) * e_subpass) << e_dual << " vs subpass " << e_subpass;
+  }
 }
 
 // Two-sided quality, which sees blur, on procedural pebbles (small distinct stones in dark
@@ -303,6 +312,59 @@ TEST(SynthesizerQuality, CutsAreCrispAndCoverTheExemplarUnlikeABlurredCopy) {
   EXPECT_GT(lo, 0.8);
   EXPECT_LT(hi, 1.3);  // crisp, not noise
   EXPECT_LT(cov, blur_coverage);
+}
+
+// Luminance autocorrelation of an image at `lag` pixels along its rows' direction (x) minus
+// along its columns (y): > 0 when the image is streaked along x.
+double streak_along_x(const ImageF& img, int lag) {
+  std::vector<double> l(size_t(img.width) * size_t(img.height));
+  double mean = 0;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) {
+      const float* p = img.at(x, y);
+      l[size_t(y) * img.width + x] = 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+      mean += l[size_t(y) * img.width + x];
+    }
+  mean /= double(l.size());
+  double var = 0, along_x = 0, along_y = 0;
+  for (double& v : l) {
+    v -= mean;
+    var += v * v;
+  }
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x + lag < img.width; ++x) along_x += l[size_t(y) * img.width + x] * l[size_t(y) * img.width + x + lag];
+  for (int y = 0; y + lag < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) along_y += l[size_t(y) * img.width + x] * l[size_t(y + lag) * img.width + x];
+  const double pairs = double(img.height) * (img.width - lag);
+  return (along_x - along_y) / pairs / (var / double(l.size()));
+}
+
+// 3D consistency: in x and y cuts of an isotropic exemplar, z is an axis like the others.
+// Zhang's slab initialisation (exemplar xy thickened along z) leaves streaks along z there
+// that one fine pass does not remove; the default scatter initialisation must not.
+TEST(SynthesizerQuality, XAndYCutsAreNotStreakedAlongZ) {
+  const auto table = small_table(ProceduralKind::kPebbles, false);
+  auto streaks = [&](Init init) {
+    SynthesisParams p = small_params();
+    p.passes = SynthesisParams{}.passes;
+    p.init = init;
+    auto s = make(table, "identity", p, 0);
+    double sum = 0;
+    int n = 0;
+    for (char axis : {'x', 'y'})
+      for (int at : {0, 21}) {
+        // Axis cuts put z on the image's y: pixel (i, j) is voxel (at, i, j) or (i, at, j).
+        const ImageF img = to_image(cut(*s, axis, at, 0, 0, 48, 48), 48, 48);
+        sum += -streak_along_x(img, 4);
+        ++n;
+      }
+    return sum / n;
+  };
+  const double scatter = streaks(Init::kScatter), slab = streaks(Init::kSlab);
+  std::printf("z-streak (autocorrelation at 4 px along z minus across): scatter %.3f, slab %.3f\n", scatter, slab);
+  EXPECT_EQ(SynthesisParams{}.init, Init::kScatter);
+  EXPECT_LT(std::abs(scatter), 0.05);
+  EXPECT_GT(slab, scatter + 0.05) << "the measure no longer sees the slabs' streaks";
 }
 
 TEST(SynthesizerOrientation, ConstantRotationTurnsTheGrain) {

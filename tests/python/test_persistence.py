@@ -92,23 +92,37 @@ def test_sigterm_exits_cleanly_and_restarts(server, exemplars):
 
 def test_volumes_stored_before_a_default_changed_keep_their_voxels(server, exemplars):
     """New volumes pin the appearance-changing defaults they were made with (typicality, fine
-    passes); a volume.json written before those were pinned (neither anywhere) comes back with
-    the values its voxels were synthesized with (typicality 0, two passes), so no release
-    changes a stored volume's look."""
+    passes, init); a volume.json written before those were pinned (none anywhere) comes back
+    with the values its voxels were synthesized with (typicality 0, two passes, slab init), and
+    one written when only typicality and passes were pinned comes back with slab init: no
+    release changes a stored volume's look."""
     a = server()
     c = a.client
     ex = upload_ready(c, exemplars["spots"])
     vol = c.create_volume(exemplar=ex["id"], seed=4)
-    assert vol["params"] == {"typicality": 0.5, "passes": 1}, vol
-    legacy = c.create_volume(exemplar=ex["id"], seed=4, params={"typicality": 0, "passes": 2})
+    assert vol["params"] == {"typicality": 0.5, "passes": 1, "init": "scatter"}, vol
+    legacy = c.create_volume(exemplar=ex["id"], seed=4, params={"typicality": 0, "passes": 2, "init": "slab"})
     want = c.slice(legacy["id"], "z", 2, (24, 24))
     assert not np.array_equal(c.slice(vol["id"], "z", 2, (24, 24)), want), "the defaults changed nothing"
+    # made when typicality and passes were pinned but init was not
+    middle = c.create_volume(exemplar=ex["id"], seed=5)
+    slab = c.create_volume(exemplar=ex["id"], seed=5, params={"init": "slab"})
+    want_middle = c.slice(slab["id"], "z", 2, (24, 24))
+    assert not np.array_equal(c.slice(middle["id"], "z", 2, (24, 24)), want_middle), "init changed nothing"
     assert a.stop(grace=10) == 0
     path = next(p for p in a.data_dir.rglob("volume.json") if vol["id"] in str(p))
     info = json.loads(path.read_text())
     del info["params"], info["spec"]["params"]
     path.write_text(json.dumps(info))
+    path = next(p for p in a.data_dir.rglob("volume.json") if middle["id"] in str(p))
+    info = json.loads(path.read_text())
+    for params in (info["params"], info["spec"]["params"]):
+        del params["init"]
+    path.write_text(json.dumps(info))
     b = server(data_dir=a.data_dir)
     got = b.client.get_volume(vol["id"])
-    assert got["params"] == {"typicality": 0, "passes": 2}, got
+    assert got["params"] == {"typicality": 0, "passes": 2, "init": "slab"}, got
     assert np.array_equal(b.client.slice(vol["id"], "z", 2, (24, 24)), want)
+    got = b.client.get_volume(middle["id"])
+    assert got["params"] == {"typicality": 0.5, "passes": 1, "init": "slab"}, got
+    assert np.array_equal(b.client.slice(middle["id"], "z", 2, (24, 24)), want_middle)

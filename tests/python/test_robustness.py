@@ -81,6 +81,24 @@ def test_passes_at_their_documented_extremes(srv):
     alive(srv)
 
 
+def test_init_takes_its_two_names_only(srv):
+    # scatter (the default, pinned when absent) and slab synthesize, differently; anything else
+    # is a 400 naming the field
+    cuts = {}
+    for value in ("scatter", "slab"):
+        r = create_volume(srv, params={"init": value})
+        assert r.status_code == 201, r.text
+        assert r.json()["params"]["init"] == value
+        got = slice_of(srv, r.json()["id"], size="8,8")
+        assert got.status_code == 200, got.text
+        cuts[value] = got.content
+    assert cuts["scatter"] != cuts["slab"]
+    assert create_volume(srv).json()["params"]["init"] == "scatter"
+    for value in ("random", "Slab", "", 1, None, ["slab"]):
+        assert_error(create_volume(srv, params={"init": value}), 400, "invalid_argument", "params.init")
+    alive(srv)
+
+
 @pytest.mark.parametrize("spec", ["identity;scale:2.1,1,1", "axis:0,0,1,30;scale:3,1,1"])
 def test_stretched_fields_synthesize_instead_of_crashing(srv, spec):
     r = create_volume(srv, field={"spec": spec})
