@@ -169,11 +169,11 @@ Api::Api(const ServerConfig& config, ExemplarService& exemplars, FieldService& f
     : config_(config), exemplars_(exemplars), fields_(fields), volumes_(volumes), meshes_(meshes), metrics_(metrics), pool_(pool),
       shutting_down_(shutting_down) {}
 
-Result<std::unique_ptr<RequestInterrupter>> Api::interrupter_for(const HttpRequest& r, const std::string& timeout) const {
+Result<std::unique_ptr<RequestInterrupter>> Api::interrupter_for(const HttpRequest& r, const std::optional<std::string>& timeout) const {
   double seconds = config_.deadline_s;
-  if (!timeout.empty()) {
+  if (timeout) {  // present, even empty (`?timeout=` is not a number: 400)
     QueryParams q;
-    SOLIDTEX_ASSIGN_OR_RETURN(q, QueryParams::parse({{"timeout", timeout}}, {"timeout"}));
+    SOLIDTEX_ASSIGN_OR_RETURN(q, QueryParams::parse({{"timeout", *timeout}}, {"timeout"}));
     SOLIDTEX_ASSIGN_OR_RETURN(seconds, q.get_double("timeout", config_.deadline_s, 0, config_.max_deadline_s));
     if (!(seconds > 0))
       return Status(StatusCode::kInvalidArgument, "must be in (0, " + std::to_string(config_.max_deadline_s) + "] (--max-deadline)",
@@ -184,7 +184,7 @@ Result<std::unique_ptr<RequestInterrupter>> Api::interrupter_for(const HttpReque
 }
 
 template <typename F>
-auto Api::interruptible(const HttpRequest& r, const std::string& timeout, const std::string& what, F&& work)
+auto Api::interruptible(const HttpRequest& r, const std::optional<std::string>& timeout, const std::string& what, F&& work)
     -> decltype(work(std::declval<Interrupter&>())) {
   auto made = interrupter_for(r, timeout);
   if (!made) return made.status();
@@ -196,7 +196,7 @@ auto Api::interruptible(const HttpRequest& r, const std::string& timeout, const 
 }
 
 Result<QueryResult> Api::query_volume(const HttpRequest& r, const std::string& kind, const TargetSet& target,
-                                      const std::string& timeout) {
+                                      const std::optional<std::string>& timeout) {
   return interruptible(r, timeout, "the " + kind,
                        [&](Interrupter& i) { return volumes_.query(r.param("id"), kind, target, i); });
 }
@@ -328,7 +328,7 @@ HttpResponse Api::create_field(const HttpRequest& r) {
   auto result = [&]() -> Result<HttpResponse> {
     SOLIDTEX_ASSIGN_OR_RETURN(QueryParams q, QueryParams::parse(r.query, {"timeout"}));
     SOLIDTEX_RETURN_IF_ERROR(require_json_body(r));
-    auto created = interruptible(r, q.get("timeout").value_or(""), "the field solve",
+    auto created = interruptible(r, q.get("timeout"), "the field solve",
                                  [&](Interrupter& i) { return fields_.create(normalized_body(r.body), i); });
     if (!created) return created.status();
     HttpResponse out = HttpResponse::json(201, *created);
@@ -348,7 +348,7 @@ HttpResponse Api::add_curve(const HttpRequest& r) {
   auto result = [&]() -> Result<HttpResponse> {
     SOLIDTEX_ASSIGN_OR_RETURN(QueryParams q, QueryParams::parse(r.query, {"timeout"}));
     SOLIDTEX_RETURN_IF_ERROR(require_json_body(r));
-    auto updated = interruptible(r, q.get("timeout").value_or(""), "the field solve",
+    auto updated = interruptible(r, q.get("timeout"), "the field solve",
                                  [&](Interrupter& i) { return fields_.add_curve(r.param("id"), normalized_body(r.body), i); });
     if (!updated) return updated.status();
     return HttpResponse::json(200, *updated);
@@ -388,7 +388,7 @@ HttpResponse Api::get_volume(const HttpRequest& r) { return respond(200, [&] { r
 HttpResponse Api::delete_volume(const HttpRequest& r) { return respond_status(volumes_.remove(r.param("id"))); }
 
 Result<HttpResponse> Api::synthesize_image(const HttpRequest& r, const std::string& kind, const TargetSet& target,
-                                           const std::string& timeout) {
+                                           const std::optional<std::string>& timeout) {
   SOLIDTEX_ASSIGN_OR_RETURN(auto q, query_volume(r, kind, target, timeout));
   const std::string shape = std::to_string(target.height) + "," + std::to_string(target.width) + ",3";
   SOLIDTEX_ASSIGN_OR_RETURN(HttpResponse out,
@@ -413,7 +413,7 @@ HttpResponse Api::slice(const HttpRequest& r) {
     SOLIDTEX_RETURN_IF_ERROR(check_each(size, 1, kMaxSide, "size"));
     SOLIDTEX_RETURN_IF_ERROR(volumes_.check_target_size(sample_count(size), "size"));
     SOLIDTEX_ASSIGN_OR_RETURN(TargetSet target, TargetSet::axis_cut(axis[0], int(at), origin[0], origin[1], size[0], size[1]));
-    return synthesize_image(r, "slice", target, q.get("timeout").value_or(""));
+    return synthesize_image(r, "slice", target, q.get("timeout"));
   }();
   return result ? *result : HttpResponse::error(result.status());
 }
@@ -435,7 +435,7 @@ HttpResponse Api::cut(const HttpRequest& r) {
     SOLIDTEX_ASSIGN_OR_RETURN(int64_t h, json_int(j["size"][1], "size", 1, kMaxCutSide));
     SOLIDTEX_RETURN_IF_ERROR(volumes_.check_target_size(w * h, "size"));
     SOLIDTEX_ASSIGN_OR_RETURN(TargetSet target, TargetSet::plane_cut(origin, u, v, int(w), int(h)));
-    return synthesize_image(r, "cut", target, q.get("timeout").value_or(""));
+    return synthesize_image(r, "cut", target, q.get("timeout"));
   }();
   return result ? *result : HttpResponse::error(result.status());
 }
@@ -450,7 +450,7 @@ HttpResponse Api::region(const HttpRequest& r) {
     // Saturated: W*H*D once wrapped int64 to a small number that passed the limit (500, bad_alloc).
     SOLIDTEX_RETURN_IF_ERROR(volumes_.check_target_size(sample_count(size), "size"));
     SOLIDTEX_ASSIGN_OR_RETURN(TargetSet target, TargetSet::box(Voxel{min[0], min[1], min[2]}, size[0], size[1], size[2]));
-    auto qr = query_volume(r, "region", target, q.get("timeout").value_or(""));
+    auto qr = query_volume(r, "region", target, q.get("timeout"));
     if (!qr) return qr.status();
     const Encoding enc = negotiate(r.accept, Encoding::kVdb);
     HttpResponse out;
@@ -504,7 +504,7 @@ HttpResponse Api::points(const HttpRequest& r) {
     }
     if (pts.empty()) return Status(StatusCode::kInvalidArgument, "holds no points", "body");
     SOLIDTEX_ASSIGN_OR_RETURN(TargetSet target, TargetSet::points(pts));
-    auto qr = query_volume(r, "points", target, q.get("timeout").value_or(""));
+    auto qr = query_volume(r, "points", target, q.get("timeout"));
     if (!qr) return qr.status();
     const Encoding enc = r.accept.find("application/json") != std::string::npos ? Encoding::kJson : Encoding::kFloat32;
     SOLIDTEX_ASSIGN_OR_RETURN(HttpResponse out,
@@ -553,10 +553,10 @@ HttpResponse Api::surface(const HttpRequest& r) {
     Placement placement;
     std::string format = "ply";
     std::vector<std::array<double, 3>> extra;
-    std::string timeout;
+    std::optional<std::string> timeout;
     if (r.multipart) return Status(StatusCode::kUnsupported, "send the mesh bytes or a JSON request", "Content-Type");
     SOLIDTEX_ASSIGN_OR_RETURN(QueryParams q, QueryParams::parse(r.query, {"timeout", "resolution", "margin", "format"}));
-    timeout = q.get("timeout").value_or("");
+    timeout = q.get("timeout");
     // With a mesh body these place the mesh and choose the answer; with a JSON body they are
     // defaults for what the body leaves out.
     format = q.get("format").value_or("ply");
@@ -666,7 +666,7 @@ HttpResponse Api::field_from_mesh(const HttpRequest& r) {
         o.curves.push_back(std::move(line));
       }
     }
-    auto created = interruptible(r, q.get("timeout").value_or(""), "the field solve",
+    auto created = interruptible(r, q.get("timeout"), "the field solve",
                                  [&](Interrupter& i) { return fields_.create_from_mesh(*mesh, o, i); });
     if (!created) return created.status();
     HttpResponse out = HttpResponse::json(201, *created);

@@ -7,6 +7,7 @@
 
 #include <atomic>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "exemplar_service.h"
@@ -59,17 +60,17 @@ class Api {
   HttpResponse field_from_mesh(const HttpRequest& r);
 
  private:
-  Result<std::unique_ptr<RequestInterrupter>> interrupter_for(const HttpRequest& r, const std::string& timeout) const;
+  Result<std::unique_ptr<RequestInterrupter>> interrupter_for(const HttpRequest& r, const std::optional<std::string>& timeout) const;
   // Runs `work(interrupter)` under the request's deadline and disconnect flag; a cancelled
   // result becomes 504 (deadline) or "cancelled" (client gone, shutdown), naming `what`.
   template <typename F>
-  auto interruptible(const HttpRequest& r, const std::string& timeout, const std::string& what, F&& work)
+  auto interruptible(const HttpRequest& r, const std::optional<std::string>& timeout, const std::string& what, F&& work)
       -> decltype(work(std::declval<Interrupter&>()));
   // A volume query (kind: slice, cut, region, points, surface) under the request's deadline.
   Result<QueryResult> query_volume(const HttpRequest& r, const std::string& kind, const TargetSet& target,
-                                   const std::string& timeout);
+                                   const std::optional<std::string>& timeout);
   Result<HttpResponse> synthesize_image(const HttpRequest& r, const std::string& kind, const TargetSet& target,
-                                        const std::string& timeout);
+                                        const std::optional<std::string>& timeout);
 
   const ServerConfig& config_;
   ExemplarService& exemplars_;

@@ -81,6 +81,17 @@ def test_passes_at_their_documented_extremes(srv):
     alive(srv)
 
 
+def test_an_empty_timeout_is_an_error_not_the_default(srv):
+    # `?timeout=` is not a number (found by the contract fuzzer): 400 naming timeout
+    vid = create_volume(srv).json()["id"]
+    assert_error(slice_of(srv, vid, timeout=""), 400, "invalid_argument", "timeout")
+    r = requests.post(f"{srv.url}/v1/volumes/{vid}/points", params={"timeout": ""}, json={"points": [[0, 0, 0]]},
+                      headers=RAW_F32, timeout=HTTP_TIMEOUT)
+    assert_error(r, 400, "invalid_argument", "timeout")
+    assert slice_of(srv, vid, timeout="5").status_code == 200
+    alive(srv)
+
+
 def test_init_takes_its_two_names_only(srv):
     # scatter (the default, pinned when absent) and slab synthesize, differently; anything else
     # is a 400 naming the field
