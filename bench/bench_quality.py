@@ -6,7 +6,8 @@ Embark's 2D texture-synthesis on the same exemplar and size.
                   [--typicality T]   (synthesis' typicality weight; default: the CLI's default)
 
 For every exemplar in ../shared/data/exemplars (wood_grain and wood_planks analysed with
---grain x, the rest with defaults, whose --grain auto gives stripes_dunes grain x): z, y and x cuts and one oblique cut of SIZE^2 through the
+--grain x, as the issue asks, the rest with defaults; --grain auto, the default, gives
+stripes_dunes grain x and tree_bark grain y, and wood grain x too): z, y and x cuts and one oblique cut of SIZE^2 through the
 origin, scored with ../shared/tools/texmetric.py (swd, coverage, energy, sharp; read its header:
 energy alone rewards blur). Embark 2D (../shared/tools/embark-ref, built into BUILD/embark-ref
 with cargo on first use) synthesizes SIZE^2 from the same exemplar. Prints one JSON document

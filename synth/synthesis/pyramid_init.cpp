@@ -31,8 +31,13 @@ CoordinateTriple scatter_triple(const Table& table, const Voxel& v, uint32_t see
 }
 }  // namespace
 
+Init resolved_init(const Table& table, Init init) {
+  if (init != Init::kAuto) return init;
+  return table.exemplars().shared() ? Init::kScatter : Init::kSlab;
+}
+
 CoordinateTriple init_triple(const Table& table, const Voxel& v, const Rot3& r, const SynthesisParams& params) {
-  if (params.init == Init::kScatter) return scatter_triple(table, v, params.seed);
+  if (resolved_init(table, params.init) == Init::kScatter) return scatter_triple(table, v, params.seed);
   const PyramidLevel coarsest{0};
   const int h = table.spacing(coarsest);
   const int n = table.params().neighborhood;

@@ -8,7 +8,7 @@
 // cut into K^3 subparts; a voxel v in the subpart with centre c reads the tiled volume at
 // w = lround(R^T (v - c)) + c, so the slab pattern turns with the local frame about c and
 // rotation-induced distortion stays bounded by K (Fig. 4).
-// Scatter initialisation (SynthesisParams::init, the default): voxel w takes the first
+// Scatter initialisation (SynthesisParams::init; auto's choice for one shared exemplar): voxel w takes the first
 // candidate triple of the exemplar pixel hash(w, seed); neither the field nor K matter, since
 // a pattern of independent draws looks the same turned. The coarse passes then grow
 // coherent patches from it, in every direction alike.
@@ -23,6 +23,10 @@
 #include "core/types.h"
 
 namespace solidtex {
+
+// The initialisation `init` stands for with this table: kAuto is kScatter when one exemplar
+// serves all three planes and kSlab otherwise (grain layouts, three images).
+Init resolved_init(const Table& table, Init init);
 
 CoordinateTriple init_triple(const Table& table, const Voxel& v, const Rot3& r, const SynthesisParams& params);
 CoordinateTriple upsample_triple(const Table& table, PyramidLevel child_level, const Voxel& v,

@@ -16,12 +16,13 @@ Result<Scheme> parse_scheme(const std::string& name) {
 }
 
 Result<Init> parse_init(const std::string& name) {
+  if (name == "auto") return Init::kAuto;
   if (name == "slab") return Init::kSlab;
   if (name == "scatter") return Init::kScatter;
-  return Status(StatusCode::kInvalidArgument, "unknown init '" + name + "' (slab, scatter)", "init");
+  return Status(StatusCode::kInvalidArgument, "unknown init '" + name + "' (auto, scatter, slab)", "init");
 }
 
-const char* init_name(Init i) { return i == Init::kSlab ? "slab" : "scatter"; }
+const char* init_name(Init i) { return i == Init::kAuto ? "auto" : i == Init::kSlab ? "slab" : "scatter"; }
 
 Result<Matcher> parse_matcher(const std::string& name) {
   if (name == "paper") return Matcher::kPaper;

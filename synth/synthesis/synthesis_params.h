@@ -31,8 +31,11 @@ enum class Scheme {
 
 // How the coarsest level's version 0 is made (pyramid_init.h).
 enum class Init {
+  kAuto,     // scatter for one shared exemplar (isotropic), slab for three planes (grain layouts,
+             // three images), each measured best there (README, Quality)
   kSlab,     // Zhang §4.1: candidate slabs (exemplar xy thickened along z) tiled per subpart;
-             // it leaves streaks along z in x and y cuts that one fine pass does not remove
+             // in isotropic solids it leaves streaks along z in x and y cuts that one fine pass
+             // does not remove; with a grain along x its slabs are planks along the grain
   kScatter,  // every coarsest voxel a hashed exemplar pixel's best candidate triple: no axis is special
 };
 Result<Init> parse_init(const std::string& name);
@@ -48,9 +51,10 @@ struct SynthesisParams {
   int passes = 1;            // correction passes at every finer level, [0, 8]
   int subpass_size = 2;      // s: s^3 subpasses per pass for subpass/grid schemes, {1, 2}
   int cell_size = 12;        // M: grid cell side in voxels of the level, [4, 64]
-  // Scatter by default, chosen by measurement (README, Quality): the x and y cuts lose the
-  // slabs' streaks along z. Volumes pin it, and volumes stored before restore with kSlab.
-  Init init = Init::kScatter;
+  // Auto by default, chosen by measurement (README, Quality): isotropic solids' x and y cuts
+  // lose the slabs' streaks along z; grained solids keep their slabs. Volumes pin it, and
+  // volumes stored before restore with kSlab. It depends on the table only, so it is stable.
+  Init init = Init::kAuto;
   int init_subpart = 32;     // K: coarsest-level voxels per slab-initialisation subpart side, even, [8, 256]
   int trilinear_levels = 2;  // the coarsest this-many levels sample neighborhoods trilinearly, [0, 8]
   uint32_t seed = 1;         // hashed with (voxel, level) wherever synthesis needs randomness

@@ -100,7 +100,7 @@ def test_volumes_stored_before_a_default_changed_keep_their_voxels(server, exemp
     c = a.client
     ex = upload_ready(c, exemplars["spots"])
     vol = c.create_volume(exemplar=ex["id"], seed=4)
-    assert vol["params"] == {"typicality": 0.5, "passes": 1, "init": "scatter"}, vol
+    assert vol["params"] == {"typicality": 0.5, "passes": 1, "init": "auto"}, vol
     legacy = c.create_volume(exemplar=ex["id"], seed=4, params={"typicality": 0, "passes": 2, "init": "slab"})
     want = c.slice(legacy["id"], "z", 2, (24, 24))
     assert not np.array_equal(c.slice(vol["id"], "z", 2, (24, 24)), want), "the defaults changed nothing"
