@@ -103,8 +103,8 @@ TEST(ApiJson, ErrorsNameTheField) {
       {{{"plane_weights", {1, 1}}}, "params.plane_weights", "must be 3 numbers"},
       {{{"plane_weights", {1, 2, 1}}}, "params.plane_weights", "must be in [0.000000, 1.000000]"},
       {{{"plane_weights", {0, 0, 0}}}, "params.plane_weights", "must not all be zero"},  // validate()
-      {{{"init_subpart", 9}}, "params.init_subpart", "must be even"},
-      {{{"init", "random"}}, "params.init", "unknown init 'random'"},                    // validate()
+      {{{"init_subpart", 9}}, "params.init_subpart", "must be even"},                    // validate()
+      {{{"init", "random"}}, "params.init", "unknown init 'random'"},
       {{{"typicality", 5}}, "params.typicality", "must be in [0.000000, 4.000000]"},
       {{{"typicality", "high"}}, "params.typicality", "must be a number"},
   };

@@ -96,7 +96,8 @@ struct ExemplarService::Impl {
       auto img = decode_image(bytes, config.image_limits, name);
       if (!img) return as_upload_error(img.status());
       if (name.rfind("mask", 0) != 0) {
-        pixels += img->pixel_count() * (name == "xy" && grain == "x" ? 3 : 1);  // grain x: xy in all planes
+        // grain x or y: xy in all planes (auto is known only after decoding; the full estimate follows)
+        pixels += img->pixel_count() * (name == "xy" && (grain == "x" || grain == "y") ? 3 : 1);
         if (const int64_t at_least = pixels * per_pixel; max_bytes > 0 && at_least > max_bytes)
           return Status(StatusCode::kUnprocessable,
                         "analysing this exemplar needs at least " + std::to_string(at_least >> 20) + " MB; the limit is " +

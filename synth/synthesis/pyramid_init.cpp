@@ -10,9 +10,7 @@ std::array<const ImageF*, kNumPlanes> exemplar_planes(const Table& table) {
   const ExemplarSet& e = table.exemplars();
   return {&e.plane(Plane::kXY), &e.plane(Plane::kYZ), &e.plane(Plane::kZX)};
 }
-}  // namespace
 
-namespace {
 // The first (best by crossbar error) candidate triple of an xy pixel; the pixel itself in
 // every plane when it has none.
 CoordinateTriple first_candidate(const Table& table, ExemplarPixel pixel) {
