@@ -60,7 +60,7 @@ Result<TargetSet> parse_cut(const Args& args) {
 Status run_slice(const std::vector<std::string>& argv) {
   Args args({"-o", "--axis", "--at", "--origin", "--plane", "--size", "--scheme", "--field", "--seed", "--threads",
              "--stats", "--passes", "--coarse-passes", "--cell", "--cache-mb", "--plane-weights", "--matcher", "--region-table", "--regions",
-             "--typicality", "--init"},
+             "--typicality", "--init", "--color"},
             {"--energy"});
   SOLIDTEX_RETURN_IF_ERROR(args.parse(argv));
   if (args.positionals().size() != 1)
@@ -73,6 +73,9 @@ Status run_slice(const std::vector<std::string>& argv) {
   }
   if (auto i = args.get("--init")) {
     SOLIDTEX_ASSIGN_OR_RETURN(params.init, parse_init(*i));
+  }
+  if (auto c = args.get("--color")) {
+    SOLIDTEX_ASSIGN_OR_RETURN(params.color, parse_color_rule(*c));
   }
   if (auto m = args.get("--matcher")) {
     SOLIDTEX_ASSIGN_OR_RETURN(params.matcher, parse_matcher(*m));

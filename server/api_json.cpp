@@ -21,7 +21,7 @@ namespace {
 // validate() runs afterwards for the rules that involve several members.
 template <typename P>
 struct Param {
-  using Member = std::variant<int P::*, uint32_t P::*, float P::*, std::array<float, 3> P::*, Scheme P::*, Matcher P::*, Init P::*>;
+  using Member = std::variant<int P::*, uint32_t P::*, float P::*, std::array<float, 3> P::*, Scheme P::*, Matcher P::*, Init P::*, ColorRule P::*>;
   const char* key;
   Member member;
   int64_t lo = 0, hi = 0;
@@ -48,6 +48,7 @@ constexpr Param<SynthesisParams> kSynthesisParams[] = {
     {"subpass_size", &SynthesisParams::subpass_size, 1, 2},
     {"cell_size", &SynthesisParams::cell_size, 4, 64},
     {"init", &SynthesisParams::init},
+    {"color", &SynthesisParams::color},
     {"init_subpart", &SynthesisParams::init_subpart, 8, 256},
     {"trilinear_levels", &SynthesisParams::trilinear_levels, 0, 8},
     {"plane_weights", &SynthesisParams::plane_weights, 0, 1},
@@ -105,6 +106,7 @@ Status read_param(const Param<P>& d, const json& v, const std::string& field, P&
           [&](Scheme P::*m) { return read_name(v, field, &parse_scheme, p.*m); },
           [&](Matcher P::*m) { return read_name(v, field, &parse_matcher, p.*m); },
           [&](Init P::*m) { return read_name(v, field, &parse_init, p.*m); },
+          [&](ColorRule P::*m) { return read_name(v, field, &parse_color_rule, p.*m); },
       },
       d.member);
 }
@@ -117,6 +119,7 @@ json write_params(const P& p, const Param<P> (&table)[N]) {
                                 [&](Scheme P::*m) { return json(scheme_name(p.*m)); },
                                 [&](Matcher P::*m) { return json(matcher_name(p.*m)); },
                                 [&](Init P::*m) { return json(init_name(p.*m)); },
+                                [&](ColorRule P::*m) { return json(color_rule_name(p.*m)); },
                                 [&](auto m) { return json(p.*m); },
                             },
                             d.member);

@@ -477,12 +477,12 @@ bool pin_params(json& spec, const json& values) {
 
 // The defaults a new volume pins (SynthesisParams), and the ones volumes stored before each
 // was pinned were synthesized with: typicality did not exist (0), fine levels ran two
-// correction passes, and the coarsest level started from slabs.
+// correction passes, the coarsest level started from slabs, and output colors were means.
 json current_defaults() {
   const SynthesisParams d;
-  return {{"typicality", d.typicality}, {"passes", d.passes}, {"init", init_name(d.init)}};
+  return {{"typicality", d.typicality}, {"passes", d.passes}, {"init", init_name(d.init)}, {"color", color_rule_name(d.color)}};
 }
-json legacy_defaults() { return {{"typicality", 0.0}, {"passes", 2}, {"init", "slab"}}; }
+json legacy_defaults() { return {{"typicality", 0.0}, {"passes", 2}, {"init", "slab"}, {"color", "mean"}}; }
 
 }  // namespace
 

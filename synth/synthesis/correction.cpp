@@ -132,12 +132,38 @@ void matching_color(const TableLevel& level, const CoordinateTriple& t, int chan
   for (int k = channels; k < 4; ++k) out[k] = 0.f;
 }
 
-void output_color(const Table& table, const CoordinateTriple& t, const PlaneWeights& w, float rgb[3]) {
+void output_color(const Table& table, const CoordinateTriple& t, const PlaneWeights& w, ColorRule rule, float rgb[3]) {
   const ExemplarSet& e = table.exemplars();
-  const float* a = e.plane(Plane::kXY).wrapped(t.at[0].x, t.at[0].y);
-  const float* b = e.plane(Plane::kYZ).wrapped(t.at[1].x, t.at[1].y);
-  const float* c = e.plane(Plane::kZX).wrapped(t.at[2].x, t.at[2].y);
-  for (int k = 0; k < 3; ++k) rgb[k] = w[0] * a[k] + w[1] * b[k] + w[2] * c[k];
+  const std::array<const float*, 3> px{e.plane(Plane::kXY).wrapped(t.at[0].x, t.at[0].y),
+                                       e.plane(Plane::kYZ).wrapped(t.at[1].x, t.at[1].y),
+                                       e.plane(Plane::kZX).wrapped(t.at[2].x, t.at[2].y)};
+  if (rule == ColorRule::kMean) {
+    for (int k = 0; k < 3; ++k) rgb[k] = w[0] * px[0][k] + w[1] * px[1][k] + w[2] * px[2][k];
+    return;
+  }
+  // Plane i's spread is its weighted squared distance to the others, divided by its own weight:
+  // with equal weights the plain medoid; a down-weighted plane (the end grain of a grain
+  // layout) is output only where it agrees with the others much better, one of weight 0 never.
+  auto spread = [&](int i) {
+    float s = 0.f;
+    for (int j = 0; j < 3; ++j)
+      for (int k = 0; k < 3; ++k) {
+        const float d = px[size_t(i)][k] - px[size_t(j)][k];
+        s += w[size_t(j)] * d * d;
+      }
+    return s / w[size_t(i)];
+  };
+  int best = -1;
+  float best_spread = 0.f;
+  for (int i = 0; i < 3; ++i) {
+    if (w[size_t(i)] <= 0.f) continue;
+    const float s = spread(i);
+    if (best < 0 || s < best_spread) {
+      best = i;
+      best_spread = s;
+    }
+  }
+  for (int k = 0; k < 3; ++k) rgb[k] = px[size_t(best)][k];
 }
 
 CorrectionContext CorrectionContext::make(const Table& table, PyramidLevel l, const SynthesisParams& params) {
@@ -145,6 +171,7 @@ CorrectionContext CorrectionContext::make(const Table& table, PyramidLevel l, co
   ctx.candidates_per_source = params.matcher == Matcher::kCoherent ? 4 : 64;
   ctx.cost_weights = params.plane_weights;
   ctx.color_weights = normalised_weights(params.plane_weights);
+  ctx.color_rule = params.color;
   ctx.typicality = params.typicality;
   ctx.level = &table.level(l);
   ctx.n = table.params().neighborhood;

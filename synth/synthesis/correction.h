@@ -23,7 +23,8 @@
 //
 // Voxel color: the matching color of a triple is the mean over the three planes of that
 // level's Gaussian-stack color at T_k (RGB plus mask channel), weighted by the plane weights;
-// the output color of a finest-level voxel is the same mean over the original exemplars' RGB.
+// the output color of a finest-level voxel is, over the original exemplars' RGB, the same mean
+// or (ColorRule::kMedoid, the default) the medoid of the three pixels.
 #pragma once
 
 #include <array>
@@ -68,7 +69,10 @@ void stencil_offsets(const ReadStencil& s, std::vector<std::array<int8_t, 3>>& o
 using PlaneWeights = std::array<float, 3>;
 PlaneWeights normalised_weights(const std::array<float, 3>& w);
 void matching_color(const TableLevel& level, const CoordinateTriple& t, int channels, const PlaneWeights& w, float* out);
-void output_color(const Table& table, const CoordinateTriple& t, const PlaneWeights& w, float rgb[3]);
+// The output color of a finest-level triple under `rule` (synthesis_params.h); the medoid's
+// ties go to the lowest plane index, so it is a pure function of (table, triple, weights).
+// `w` are normalised weights (not all zero).
+void output_color(const Table& table, const CoordinateTriple& t, const PlaneWeights& w, ColorRule rule, float rgb[3]);
 
 // Per-level constants of the correction, precomputed once per synthesizer.
 struct CorrectionContext {
@@ -81,6 +85,7 @@ struct CorrectionContext {
   PlaneWeights cost_weights{1.f, 1.f, 1.f};          // per-plane matching weights
   int candidates_per_source = 64;                    // table candidates tried per source pixel
   PlaneWeights color_weights{1.f / 3, 1.f / 3, 1.f / 3};
+  ColorRule color_rule = ColorRule::kMedoid;         // output colors only (finest level)
   float typicality = 0.f;                            // SynthesisParams::typicality
   static CorrectionContext make(const Table& table, PyramidLevel l, const SynthesisParams& params);
 };

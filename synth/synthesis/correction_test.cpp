@@ -1,6 +1,6 @@
 // best_candidate's pruning (own-plane cost once per source, cheapest source first, lower-bound
 // skips) must pick exactly what evaluating every candidate in full would: the same triple, for
-// every plane weighting, typicality and candidate budget.
+// every plane weighting, typicality and candidate budget. Output colors: mean and medoid.
 #include "synthesis/correction.h"
 
 #include <gtest/gtest.h>
@@ -116,6 +116,48 @@ TEST(Correction, PrunedSearchPicksWhatTheFullSearchPicks) {
   }
   EXPECT_EQ(cases, 2 * 3 * 2 * 2 * 2 * 60);
   EXPECT_GT(moved, cases / 2);  // the searches mostly pick a candidate, not the current triple
+}
+
+// Output colors: the medoid is always one of the triple's three exemplar pixels, the one whose
+// weighted squared distance to the others over its own weight is least (lowest plane on ties);
+// a plane of weight 0 is never output; the mean is the weighted mean.
+TEST(Correction, OutputColorMedoidIsTheTriplesMostCentralExemplarPixel) {
+  const auto table = table_of(ProceduralKind::kPebbles, true);
+  const ExemplarSet& e = table->exemplars();
+  const int w = e.plane(Plane::kXY).width;
+  int64_t picked[3] = {0, 0, 0};
+  for (const std::array<float, 3> raw : {std::array<float, 3>{1, 1, 1}, std::array<float, 3>{1, 1, 0.1f},
+                                         std::array<float, 3>{0, 1, 1}}) {
+    const PlaneWeights pw = normalised_weights(raw);
+    for (uint64_t trial = 0; trial < 300; ++trial) {
+      CoordinateTriple t;
+      for (int k = 0; k < 3; ++k)
+        t.at[size_t(k)] = {int(hash_u64(trial, k, 1, 7) % uint64_t(w)), int(hash_u64(trial, k, 2, 7) % uint64_t(w))};
+      const float* px[3] = {e.plane(Plane::kXY).wrapped(t.at[0].x, t.at[0].y), e.plane(Plane::kYZ).wrapped(t.at[1].x, t.at[1].y),
+                            e.plane(Plane::kZX).wrapped(t.at[2].x, t.at[2].y)};
+      float mean[3], medoid[3];
+      output_color(*table, t, pw, ColorRule::kMean, mean);
+      output_color(*table, t, pw, ColorRule::kMedoid, medoid);
+      for (int c = 0; c < 3; ++c) EXPECT_FLOAT_EQ(mean[c], pw[0] * px[0][c] + pw[1] * px[1][c] + pw[2] * px[2][c]);
+      double spread[3];
+      int want = -1;
+      for (int i = 0; i < 3; ++i) {
+        spread[i] = 0;
+        for (int j = 0; j < 3; ++j)
+          for (int c = 0; c < 3; ++c) spread[i] += pw[size_t(j)] * double(px[i][c] - px[j][c]) * double(px[i][c] - px[j][c]);
+        if (pw[size_t(i)] > 0 && (want < 0 || spread[i] / pw[size_t(i)] < spread[want] / pw[size_t(want)] - 1e-9)) want = i;
+      }
+      int got = -1;
+      for (int i = 0; i < 3 && got < 0; ++i)
+        if (medoid[0] == px[i][0] && medoid[1] == px[i][1] && medoid[2] == px[i][2]) got = i;
+      ASSERT_GE(got, 0) << "the medoid is not one of the triple's exemplar colors (trial " << trial << ")";
+      ASSERT_GT(pw[size_t(got)], 0.f);
+      // Equal colors make several planes valid answers; compare spreads, not indices.
+      EXPECT_NEAR(spread[got] / pw[size_t(got)], spread[want] / pw[size_t(want)], 1e-6);
+      ++picked[want];
+    }
+  }
+  for (int i = 0; i < 3; ++i) EXPECT_GT(picked[i], 30) << "plane " << i << " is (almost) never the medoid";
 }
 
 }  // namespace

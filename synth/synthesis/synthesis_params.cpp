@@ -24,6 +24,14 @@ Result<Init> parse_init(const std::string& name) {
 
 const char* init_name(Init i) { return i == Init::kAuto ? "auto" : i == Init::kSlab ? "slab" : "scatter"; }
 
+Result<ColorRule> parse_color_rule(const std::string& name) {
+  if (name == "mean") return ColorRule::kMean;
+  if (name == "medoid") return ColorRule::kMedoid;
+  return Status(StatusCode::kInvalidArgument, "unknown color '" + name + "' (mean, medoid)", "color");
+}
+
+const char* color_rule_name(ColorRule c) { return c == ColorRule::kMean ? "mean" : "medoid"; }
+
 Result<Matcher> parse_matcher(const std::string& name) {
   if (name == "paper") return Matcher::kPaper;
   if (name == "coherent") return Matcher::kCoherent;

@@ -404,7 +404,7 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize_piece(const Ta
     const Voxel& p = target.voxels[i];
     const int slot = fsch.slot(p, fsch.final_version());
     checks.read(*parent, p, slot);
-    output_color(*table_, parent->triple(p, slot), fctx.color_weights, voxel_rgb[i].data());
+    output_color(*table_, parent->triple(p, slot), fctx.color_weights, fctx.color_rule, voxel_rgb[i].data());
   }
   checks.count_unread(fsch, deps[size_t(finest.index)], *parent);
   stats.unsound_reads = checks.unsound();

@@ -249,12 +249,14 @@ TEST_F(SynthesizerTest, CorrectionLowersMatchingEnergyAndDualGridKeepsQuality) {
     return e;
   };
   // Plain L2 matching, the objective energy measures; the typicality penalty trades some of it
-  // for crispness (SynthesizerQuality judges that with two-sided measures).
+  // for crispness (SynthesizerQuality judges that with two-sided measures). Mean output colors,
+  // the colors matching compares: medoid colors are crisper, which this energy penalises.
   for (const Init init : {Init::kSlab, Init::kScatter}) {
     SCOPED_TRACE(init_name(init));
     auto plain = [&](Scheme scheme) {
       SynthesisParams p = small_params(scheme);
       p.typicality = 0.f;
+      p.color = ColorRule::kMean;
       p.init = init;
       return p;
     };
@@ -313,6 +315,44 @@ TEST(SynthesizerQuality, CutsAreCrispAndCoverTheExemplarUnlikeABlurredCopy) {
   EXPECT_GT(lo, 0.8);
   EXPECT_LT(hi, 1.3);  // crisp, not noise
   EXPECT_LT(cov, blur_coverage);
+}
+
+// Medoid output colors (the default) are the exemplar's own colors, where the plane-weighted
+// mean of a triple's three pixels is a color none of them has wherever they disagree; on the
+// same triples (the rule does not change synthesis) the medoid's cuts are at least as sharp.
+TEST(SynthesizerQuality, MedoidColorsAreExemplarColorsAndNoBlurrierThanMeans) {
+  const auto table = small_table(ProceduralKind::kPebbles, false);
+  const ImageF& exemplar = table->exemplars().plane(Plane::kXY);
+  std::vector<std::array<float, 3>> palette;
+  for (int y = 0; y < exemplar.height; ++y)
+    for (int x = 0; x < exemplar.width; ++x) palette.push_back({exemplar.at(x, y)[0], exemplar.at(x, y)[1], exemplar.at(x, y)[2]});
+  std::sort(palette.begin(), palette.end());
+  auto share_of_exemplar_colors = [&](const std::vector<std::array<float, 3>>& rgb) {
+    size_t in = 0;
+    for (const auto& c : rgb) in += std::binary_search(palette.begin(), palette.end(), c);
+    return double(in) / double(rgb.size());
+  };
+  auto cuts = [&](ColorRule rule, double& share, double& sharp) {
+    SynthesisParams p = small_params();
+    p.passes = SynthesisParams{}.passes;
+    p.color = rule;
+    auto s = make(table, "identity", p, 0);
+    share = 1, sharp = 0;
+    for (char axis : {'x', 'z'}) {
+      const auto rgb = cut(*s, axis, 7, 0, 0, 40, 40);
+      share = std::min(share, share_of_exemplar_colors(rgb));
+      sharp += sharpness_ratio(to_image(rgb, 40, 40), exemplar) / 2;
+    }
+  };
+  double share_medoid = 0, sharp_medoid = 0, share_mean = 0, sharp_mean = 0;
+  EXPECT_EQ(SynthesisParams{}.color, ColorRule::kMedoid);
+  cuts(ColorRule::kMedoid, share_medoid, sharp_medoid);
+  cuts(ColorRule::kMean, share_mean, sharp_mean);
+  std::printf("exemplar colors: medoid %.3f, mean %.3f; sharpness: medoid %.3f, mean %.3f\n", share_medoid, share_mean,
+              sharp_medoid, sharp_mean);
+  EXPECT_EQ(share_medoid, 1.0);
+  EXPECT_LT(share_mean, 0.9) << "the three planes always agree here: the test no longer tells the rules apart";
+  EXPECT_GE(sharp_medoid, sharp_mean);
 }
 
 // Luminance autocorrelation of an image at `lag` pixels along its rows' direction (x) minus

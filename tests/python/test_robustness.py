@@ -112,6 +112,24 @@ def test_init_takes_its_three_names_only(srv):
     alive(srv)
 
 
+def test_color_takes_its_two_names_only(srv):
+    # medoid (the default, pinned when absent) and mean synthesize the same triples and differ
+    # in colors only; anything else is a 400 naming the field
+    cuts = {}
+    for value in ("medoid", "mean"):
+        r = create_volume(srv, params={"color": value})
+        assert r.status_code == 201, r.text
+        assert r.json()["params"]["color"] == value
+        got = slice_of(srv, r.json()["id"], size="8,8")
+        assert got.status_code == 200, got.text
+        cuts[value] = got.content
+    assert cuts["medoid"] != cuts["mean"]
+    assert create_volume(srv).json()["params"]["color"] == "medoid"
+    for value in ("median", "Mean", "", 0, None, ["mean"], {"rule": "mean"}):
+        assert_error(create_volume(srv, params={"color": value}), 400, "invalid_argument", "params.color")
+    alive(srv)
+
+
 @pytest.mark.parametrize("spec", ["identity;scale:2.1,1,1", "axis:0,0,1,30;scale:3,1,1"])
 def test_stretched_fields_synthesize_instead_of_crashing(srv, spec):
     r = create_volume(srv, field={"spec": spec})
