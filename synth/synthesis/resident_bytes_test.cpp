@@ -102,12 +102,12 @@ TEST_F(ResidentBytesTest, VoxelCacheBytesAreWhatItHolds) {
   const int64_t measured = heap_in_use() - before;
   const auto c = cache.counters();
   EXPECT_EQ(c.bricks, 800);
-  EXPECT_EQ(c.bytes, 800 * VoxelCache::brick_bytes());
+  EXPECT_EQ(c.bytes, 800 * VoxelCache::brick_bytes(1));
   expect_near_measured(c.bytes, measured, "voxel cache");
   // Eviction gives it back.
-  cache.set_budget_bytes(100 * VoxelCache::brick_bytes());
-  EXPECT_LE(cache.counters().bytes, 90 * VoxelCache::brick_bytes());
-  EXPECT_LT(heap_in_use() - before, 100 * VoxelCache::brick_bytes() + 400 * 8 * 2 + 16384);
+  cache.set_budget_bytes(100 * VoxelCache::brick_bytes(1));
+  EXPECT_LE(cache.counters().bytes, 90 * VoxelCache::brick_bytes(1));
+  EXPECT_LT(heap_in_use() - before, 100 * VoxelCache::brick_bytes(1) + 400 * 8 * 2 + 16384);
 }
 
 }  // namespace

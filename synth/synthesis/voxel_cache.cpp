@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <array>
+#include <memory>
 #include <mutex>
 #include <tuple>
 #include <unordered_map>
+#include <utility>
 
 #include "core/hash.h"
 
@@ -41,20 +43,57 @@ struct BrickKeyHash {
 BrickKey key_of(const Voxel& v) { return {v.x >> 3, v.y >> 3, v.z >> 3}; }
 int slot_of(const Voxel& v) { return (v.x & 7) | ((v.y & 7) << 3) | ((v.z & 7) << 6); }
 
+// A brick stores only its present voxels' values, in slot order (a voxel's index is the number
+// of present voxels before its slot): a cut fills bricks partly, often one 8^2 layer of 512, and
+// dense bricks would cost 96 bytes per cached voxel there instead of ~14.
 struct Brick {
-  std::array<Packed, 512> values{};
   std::array<uint64_t, 8> present{};  // one bit per voxel
+  std::unique_ptr<Packed[]> values;   // count() entries, exactly sized
   uint64_t last_use = 0;
   bool has(int s) const { return (present[size_t(s >> 6)] >> (s & 63)) & 1u; }
+  int count() const {
+    int n = 0;
+    for (uint64_t w : present) n += __builtin_popcountll(w);
+    return n;
+  }
+  int index_of(int s) const {
+    int n = 0;
+    for (int w = 0; w < (s >> 6); ++w) n += __builtin_popcountll(present[size_t(w)]);
+    return n + __builtin_popcountll(present[size_t(s >> 6)] & ((uint64_t(1) << (s & 63)) - 1));
+  }
 };
 
 using BrickMap = std::unordered_map<BrickKey, Brick, BrickKeyHash>;
 
-// What one brick costs in memory: the map node (key, brick, next pointer, cached hash), its
-// bucket and the allocator's header and rounding. The budget counts this, so --cache-mb bounds
-// what the cache really holds (no tree nodes or side tables beside the bricks).
-constexpr int64_t kBrickBytes =
-    int64_t((sizeof(BrickKey) + sizeof(Brick) + 2 * sizeof(void*) + 16 + 15) / 16 * 16 + sizeof(void*));
+// What a brick of n voxels costs in memory: the map node (key, brick, next pointer, cached
+// hash) and its bucket, plus the value array, each with glibc malloc's 8-byte header rounded up
+// to 16 (32 at least). The budget counts this, so --cache-mb bounds what the cache really holds
+// (no tree nodes or side tables beside the bricks).
+constexpr int64_t malloc_chunk(int64_t bytes) { return std::max<int64_t>(32, (bytes + 8 + 15) / 16 * 16); }
+constexpr int64_t kNodeBytes = malloc_chunk(int64_t(sizeof(BrickKey) + sizeof(Brick) + 2 * sizeof(void*))) + int64_t(sizeof(void*));
+int64_t brick_cost(int voxels) { return kNodeBytes + (voxels > 0 ? malloc_chunk(int64_t(voxels) * int64_t(sizeof(Packed))) : 0); }
+
+// Writes a run of (slot, value) pairs of one brick: new slots are merged in, slot order kept.
+void write_run(Brick& b, const std::vector<std::pair<int, Packed>>& run, int64_t& new_voxels) {
+  std::array<uint64_t, 8> present = b.present;
+  for (const auto& [s, v] : run) present[size_t(s >> 6)] |= uint64_t(1) << (s & 63);
+  int added = 0;
+  for (size_t w = 0; w < 8; ++w) added += __builtin_popcountll(present[w] & ~b.present[w]);
+  if (added > 0) {
+    const int n = b.count() + added;
+    auto values = std::make_unique<Packed[]>(size_t(n));
+    int from = 0, to = 0;
+    for (size_t w = 0; w < 8; ++w)
+      for (uint64_t bits = present[w]; bits; bits &= bits - 1) {
+        const bool old = (b.present[w] >> __builtin_ctzll(bits)) & 1u;
+        values[size_t(to++)] = old ? b.values[size_t(from++)] : Packed{};
+      }
+    b.values = std::move(values);
+    b.present = present;
+    new_voxels += added;
+  }
+  for (const auto& [s, v] : run) b.values[size_t(b.index_of(s))] = v;
+}
 
 }  // namespace
 
@@ -64,6 +103,7 @@ struct VoxelCache::Impl {
   uint64_t tick = 0;
   Counters counters;
   int64_t bricks = 0;
+  int64_t bytes = 0;  // sum of brick_cost over the bricks
 
   void evict_to(int64_t target) {
     std::vector<std::tuple<uint64_t, int, BrickKey>> all;
@@ -72,11 +112,11 @@ struct VoxelCache::Impl {
       for (const auto& [key, b] : levels[l]) all.emplace_back(b.last_use, int(l), key);
     std::sort(all.begin(), all.end());  // least recently used first; ties by level, then brick
     for (const auto& [t, l, key] : all) {
-      if (bricks * kBrickBytes <= target) break;
+      if (bytes <= target) break;
       auto it = levels[size_t(l)].find(key);
-      int64_t n = 0;
-      for (uint64_t w : it->second.present) n += __builtin_popcountll(w);
+      const int n = it->second.count();
       counters.voxels_per_level[size_t(l)] -= n;
+      bytes -= brick_cost(n);
       levels[size_t(l)].erase(it);
       --bricks;
       ++counters.evicted_bricks;
@@ -91,7 +131,7 @@ VoxelCache::VoxelCache(int levels, int64_t budget_bytes) : impl_(std::make_uniqu
 
 VoxelCache::~VoxelCache() = default;
 
-int64_t VoxelCache::brick_bytes() { return kBrickBytes; }
+int64_t VoxelCache::brick_bytes(int voxels) { return brick_cost(voxels); }
 
 int64_t VoxelCache::lookup(PyramidLevel level, const std::vector<Voxel>& voxels, std::vector<CoordinateTriple>& out,
                            std::vector<uint8_t>& found) {
@@ -115,7 +155,7 @@ int64_t VoxelCache::lookup(PyramidLevel level, const std::vector<Voxel>& voxels,
     if (!last) continue;
     const int s = slot_of(voxels[i]);
     if (!last->has(s)) continue;
-    out[i] = unpack(last->values[size_t(s)]);
+    out[i] = unpack(last->values[size_t(last->index_of(s))]);
     found[i] = 1;
     ++hits;
     last->last_use = now;
@@ -131,39 +171,39 @@ void VoxelCache::insert(PyramidLevel level, const std::vector<Voxel>& voxels, co
   std::lock_guard<std::mutex> g(impl_->mutex);
   BrickMap& map = impl_->levels[size_t(level.index)];
   const uint64_t now = ++impl_->tick;
-  BrickKey last_key{};
-  Brick* last = nullptr;
-  for (size_t i = 0; i < voxels.size(); ++i) {
+  // Runs of consecutive voxels in one brick (callers pass voxels brick by brick) are merged
+  // into it at once; a brick met again later just takes another run.
+  std::vector<std::pair<int, Packed>> run;
+  for (size_t i = 0; i < voxels.size();) {
     const BrickKey k = key_of(voxels[i]);
-    if (!last || !(k == last_key)) {
-      auto [it, inserted] = map.try_emplace(k);
-      if (inserted) ++impl_->bricks;
-      last = &it->second;
-      last_key = k;
-    }
-    const int s = slot_of(voxels[i]);
-    if (!last->has(s)) {
-      last->present[size_t(s >> 6)] |= uint64_t(1) << (s & 63);
-      ++impl_->counters.voxels_per_level[size_t(level.index)];
-      ++impl_->counters.inserted;
-    }
-    last->values[size_t(s)] = pack(triples[i]);
-    last->last_use = now;
+    run.clear();
+    for (; i < voxels.size() && key_of(voxels[i]) == k; ++i) run.emplace_back(slot_of(voxels[i]), pack(triples[i]));
+    auto [it, inserted] = map.try_emplace(k);
+    Brick& b = it->second;
+    if (inserted) ++impl_->bricks;
+    const int before = inserted ? 0 : b.count();
+    int64_t added = 0;
+    write_run(b, run, added);
+    impl_->bytes += brick_cost(before + int(added)) - (inserted ? 0 : brick_cost(before));
+    impl_->counters.voxels_per_level[size_t(level.index)] += added;
+    impl_->counters.inserted += added;
+    b.last_use = now;
   }
   // Evict least-recently-used bricks (over all levels) while over budget, down to 90% of it.
-  if (impl_->bricks * kBrickBytes > budget) impl_->evict_to(budget * 9 / 10);
+  if (impl_->bytes > budget) impl_->evict_to(budget * 9 / 10);
 }
 
 void VoxelCache::set_budget_bytes(int64_t bytes) {
   budget_.store(bytes);
   std::lock_guard<std::mutex> g(impl_->mutex);
-  if (impl_->bricks * kBrickBytes > bytes) impl_->evict_to(std::max<int64_t>(0, bytes) * 9 / 10);
+  if (impl_->bytes > bytes) impl_->evict_to(std::max<int64_t>(0, bytes) * 9 / 10);
 }
 
 void VoxelCache::clear() {
   std::lock_guard<std::mutex> g(impl_->mutex);
   for (auto& m : impl_->levels) BrickMap().swap(m);  // frees the buckets too
   impl_->bricks = 0;
+  impl_->bytes = 0;
   std::fill(impl_->counters.voxels_per_level.begin(), impl_->counters.voxels_per_level.end(), 0);
 }
 
@@ -171,7 +211,7 @@ VoxelCache::Counters VoxelCache::counters() const {
   std::lock_guard<std::mutex> g(impl_->mutex);
   Counters c = impl_->counters;
   c.bricks = impl_->bricks;
-  c.bytes = c.bricks * kBrickBytes;
+  c.bytes = impl_->bytes;
   return c;
 }
 

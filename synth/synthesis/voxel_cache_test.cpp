@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -36,9 +37,11 @@ int64_t found_count(VoxelCache& c, int level, const std::vector<Voxel>& v) {
   return c.lookup(PyramidLevel{level}, v, out, found);
 }
 
-int64_t one_brick_bytes() {
+// What a brick of brick(o)'s four voxels costs, as the cache counts it.
+int64_t four_voxel_brick_bytes() {
   VoxelCache c(1, int64_t(1) << 30);
-  c.insert(PyramidLevel{0}, {{0, 0, 0}}, {CoordinateTriple{}});
+  c.insert(PyramidLevel{0}, brick({0, 0, 0}), triples_for(brick({0, 0, 0}), 0));
+  EXPECT_EQ(c.counters().bytes, VoxelCache::brick_bytes(4));
   return c.counters().bytes;
 }
 
@@ -99,9 +102,7 @@ TEST(VoxelCache, LevelsAreIndependent) {
 }
 
 TEST(VoxelCache, CountersTrackHitsMissesInsertsAndBricks) {
-  const int64_t leaf = one_brick_bytes();
-  ASSERT_GT(leaf, 512 * 12);  // at least the 512 Vec3i values
-  VoxelCache c(2, int64_t(1) << 30);
+    VoxelCache c(2, int64_t(1) << 30);
   auto k = c.counters();
   EXPECT_EQ(k.hits, 0);
   EXPECT_EQ(k.misses, 0);
@@ -114,7 +115,8 @@ TEST(VoxelCache, CountersTrackHitsMissesInsertsAndBricks) {
   k = c.counters();
   EXPECT_EQ(k.inserted, 6);
   EXPECT_EQ(k.bricks, 4);  // (-1,0,0) and (-8,0,0) share [-8, 0); (0,0,0) and (7,7,7) share [0, 8)
-  EXPECT_EQ(k.bytes, 4 * leaf);
+  const int64_t four_bricks = 2 * VoxelCache::brick_bytes(2) + 2 * VoxelCache::brick_bytes(1);
+  EXPECT_EQ(k.bytes, four_bricks);
   EXPECT_EQ(k.voxels_per_level[0], 6);
   // Re-inserting cached voxels adds nothing.
   c.insert(PyramidLevel{0}, {v[0], v[1]}, triples_for({v[0], v[1]}, 0));
@@ -126,7 +128,7 @@ TEST(VoxelCache, CountersTrackHitsMissesInsertsAndBricks) {
   c.insert(PyramidLevel{1}, {{0, 0, 0}}, {triple_for({0, 0, 0}, 1)});
   k = c.counters();
   EXPECT_EQ(k.bricks, 5);
-  EXPECT_EQ(k.bytes, 5 * leaf);
+  EXPECT_EQ(k.bytes, four_bricks + VoxelCache::brick_bytes(1));
   EXPECT_EQ(k.inserted, 7);
   // Lookups: 3 hits and 2 misses, then 0 and 4.
   EXPECT_EQ(found_count(c, 0, {{-1, 0, 0}, {1, 0, 0}, {7, 7, 7}, {-9, 0, 0}, {-9, 0, -1}}), 3);
@@ -141,7 +143,7 @@ TEST(VoxelCache, CountersTrackHitsMissesInsertsAndBricks) {
 }
 
 TEST(VoxelCache, SmallBudgetEvictsTheLeastRecentlyUsedBrick) {
-  const int64_t leaf = one_brick_bytes();
+  const int64_t leaf = four_voxel_brick_bytes();
   const Voxel a{0, 0, 0}, b{8, 0, 0}, cc{-8, 0, 0}, d{0, -8, 0};
   // Room for three and a half bricks: a fourth evicts one (down to <= 90% of the budget).
   for (const bool touch_a : {false, true}) {
@@ -173,7 +175,7 @@ TEST(VoxelCache, SmallBudgetEvictsTheLeastRecentlyUsedBrick) {
 }
 
 TEST(VoxelCache, EvictionIsLeastRecentlyUsedAcrossLevels) {
-  const int64_t leaf = one_brick_bytes();
+  const int64_t leaf = four_voxel_brick_bytes();
   VoxelCache c(2, 3 * leaf + leaf / 2);
   const Voxel o{-16, -16, -16};
   c.insert(PyramidLevel{1}, brick(o), triples_for(brick(o), 1));  // oldest
@@ -191,7 +193,7 @@ TEST(VoxelCache, EvictionIsLeastRecentlyUsedAcrossLevels) {
 }
 
 TEST(VoxelCache, LoweringTheBudgetEvictsAtOnce) {
-  const int64_t leaf = one_brick_bytes();
+  const int64_t leaf = four_voxel_brick_bytes();
   VoxelCache c(1, 100 * leaf);
   EXPECT_EQ(c.budget_bytes(), 100 * leaf);
   for (int i = 0; i < 10; ++i)
@@ -227,19 +229,64 @@ TEST(VoxelCache, BricksFarApartAreDistinctAndEachCostsOneBrick) {
   c.insert(PyramidLevel{0}, v, triples_for(v, 0));
   auto k = c.counters();
   EXPECT_EQ(k.bricks, int64_t(v.size()));
-  EXPECT_EQ(k.bytes, int64_t(v.size()) * VoxelCache::brick_bytes());
+  EXPECT_EQ(k.bytes, int64_t(v.size()) * VoxelCache::brick_bytes(1));
   std::vector<CoordinateTriple> out;
   std::vector<uint8_t> found;
   ASSERT_EQ(c.lookup(PyramidLevel{0}, v, out, found), int64_t(v.size()));
   for (size_t i = 0; i < v.size(); ++i) EXPECT_EQ(out[i], triple_for(v[i], 0)) << i;
   // A budget of two bricks keeps the two used last, whatever their coordinates.
-  c.set_budget_bytes(2 * VoxelCache::brick_bytes() + VoxelCache::brick_bytes() / 2);
+  c.set_budget_bytes(2 * VoxelCache::brick_bytes(1) + VoxelCache::brick_bytes(1) / 2);
   EXPECT_EQ(found_count(c, 0, {v[1]}), 1);
   c.insert(PyramidLevel{0}, {v[4]}, {triple_for(v[4], 0)});
   k = c.counters();
   EXPECT_EQ(k.bricks, 2);
   EXPECT_EQ(found_count(c, 0, {v[1], v[4]}), 2);
   EXPECT_EQ(found_count(c, 0, {v[0], v[2], v[3], v[5]}), 0);
+}
+
+// Bricks hold their present voxels only: values survive inserts in any order, merged into
+// bricks that already hold others, and overwrites; a cut's one-layer bricks cost under 16 bytes
+// per voxel (issue #13's budget), full bricks about 12.
+TEST(VoxelCache, SparseBricksMergeInsertsAndCostWhatTheyHold) {
+  EXPECT_GE(VoxelCache::brick_bytes(512), 512 * 12);
+  EXPECT_LT(double(VoxelCache::brick_bytes(512)) / 512, 12.5);
+  EXPECT_LT(double(VoxelCache::brick_bytes(64)) / 64, 16.0);
+  EXPECT_LT(VoxelCache::brick_bytes(1), VoxelCache::brick_bytes(64));
+  VoxelCache c(1, int64_t(1) << 30);
+  // A z layer of 24 x 24 voxels (9 bricks of 64), inserted odd rows first, then even rows
+  // backwards, then a second layer into the same bricks, then overwrites of a few.
+  std::vector<Voxel> odd, even, layer2;
+  for (int y = 0; y < 24; ++y)
+    for (int x = 0; x < 24; ++x) (y % 2 ? odd : even).push_back({x - 8, y - 8, 3});
+  std::reverse(even.begin(), even.end());
+  for (int y = 0; y < 24; ++y)
+    for (int x = 0; x < 24; ++x) layer2.push_back({x - 8, y - 8, 5});
+  c.insert(PyramidLevel{0}, odd, triples_for(odd, 0));
+  c.insert(PyramidLevel{0}, even, triples_for(even, 0));
+  auto k = c.counters();
+  EXPECT_EQ(k.bricks, 9);
+  EXPECT_EQ(k.bytes, 9 * VoxelCache::brick_bytes(64));
+  EXPECT_LT(double(k.bytes) / 576, 16.0);
+  c.insert(PyramidLevel{0}, layer2, triples_for(layer2, 0));
+  EXPECT_EQ(c.counters().bytes, 9 * VoxelCache::brick_bytes(128));
+  const std::vector<Voxel> again = {odd[3], layer2[100], even[7]};
+  std::vector<CoordinateTriple> other = triples_for(again, 1);
+  c.insert(PyramidLevel{0}, again, other);
+  k = c.counters();
+  EXPECT_EQ(k.inserted, 1152);
+  EXPECT_EQ(k.voxels_per_level[0], 1152);
+  std::vector<Voxel> all = odd;
+  all.insert(all.end(), even.begin(), even.end());
+  all.insert(all.end(), layer2.begin(), layer2.end());
+  std::vector<CoordinateTriple> out;
+  std::vector<uint8_t> found;
+  ASSERT_EQ(c.lookup(PyramidLevel{0}, all, out, found), int64_t(all.size()));
+  for (size_t i = 0; i < all.size(); ++i) {
+    const auto hit = std::find(again.begin(), again.end(), all[i]);
+    const CoordinateTriple want = hit == again.end() ? triple_for(all[i], 0) : other[size_t(hit - again.begin())];
+    ASSERT_EQ(out[i], want) << all[i].x << "," << all[i].y << "," << all[i].z;
+  }
+  EXPECT_EQ(found_count(c, 0, {{0, 0, 4}, {-8, -8, 2}, {15, 15, 6}}), 0);
 }
 
 TEST(VoxelCache, ZeroBudgetCachesNothing) {
