@@ -60,7 +60,7 @@ Result<TargetSet> parse_cut(const Args& args) {
 Status run_slice(const std::vector<std::string>& argv) {
   Args args({"-o", "--axis", "--at", "--origin", "--plane", "--size", "--scheme", "--field", "--seed", "--threads",
              "--stats", "--passes", "--coarse-passes", "--cell", "--cache-mb", "--plane-weights", "--matcher", "--region-table", "--regions",
-             "--typicality", "--init", "--color"},
+             "--typicality", "--init", "--color", "--finest-subpass-size"},
             {"--energy"});
   SOLIDTEX_RETURN_IF_ERROR(args.parse(argv));
   if (args.positionals().size() != 1)
@@ -85,6 +85,7 @@ Status run_slice(const std::vector<std::string>& argv) {
   SOLIDTEX_ASSIGN_OR_RETURN(params.passes, args.get_int("--passes", params.passes, 0, 8));
   SOLIDTEX_ASSIGN_OR_RETURN(params.coarse_passes, args.get_int("--coarse-passes", params.coarse_passes, 0, 8));
   SOLIDTEX_ASSIGN_OR_RETURN(params.cell_size, args.get_int("--cell", params.cell_size, 4, 64));
+  SOLIDTEX_ASSIGN_OR_RETURN(params.finest_subpass_size, args.get_int("--finest-subpass-size", params.finest_subpass_size, 1, 2));
   SOLIDTEX_ASSIGN_OR_RETURN(auto table, load_table(args.positionals()[0]));
   params.plane_weights = table->params().suggested_plane_weights;
   if (args.has("--plane-weights")) {

@@ -46,6 +46,7 @@ constexpr Param<SynthesisParams> kSynthesisParams[] = {
     {"coarse_passes", &SynthesisParams::coarse_passes, 0, 8},
     {"passes", &SynthesisParams::passes, 0, 8},
     {"subpass_size", &SynthesisParams::subpass_size, 1, 2},
+    {"finest_subpass_size", &SynthesisParams::finest_subpass_size, 1, 2},
     {"cell_size", &SynthesisParams::cell_size, 4, 64},
     {"init", &SynthesisParams::init},
     {"color", &SynthesisParams::color},

@@ -26,7 +26,7 @@ Inputs make_setup(const std::string& field, Scheme scheme, int n, int levels, in
   p.coarse_passes = 2;
   p.cell_size = cell;
   s.stencils = FrameStencils::make(*s.field, n, levels, p.trilinear_levels).value();
-  for (int l = 0; l < levels; ++l) s.schedules.push_back(LevelSchedule::make(l, p));
+  for (int l = 0; l < levels; ++l) s.schedules.push_back(LevelSchedule::make(l, levels, p));
   return s;
 }
 

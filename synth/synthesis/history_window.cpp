@@ -82,12 +82,12 @@ std::vector<int> HistoryWindow::materialize(const Voxel& p, int d) const {
   return out;
 }
 
-LevelSchedule LevelSchedule::make(int level, const SynthesisParams& params) {
+LevelSchedule LevelSchedule::make(int level, int levels, const SynthesisParams& params) {
   LevelSchedule s;
   const bool coarsest = level == 0;
   const int passes = coarsest ? params.coarse_passes : params.passes;
   const bool plain = coarsest || params.scheme == Scheme::kPlain;
-  s.s_ = plain ? 1 : params.subpass_size;
+  s.s_ = plain ? 1 : level == levels - 1 ? params.finest_subpass_size : params.subpass_size;
   const int classes = s.s_ == 1 ? 1 : 8;
   const CellLattice primary{params.cell_size, 0};
   const CellLattice dual{params.cell_size, params.cell_size / 2};

@@ -104,7 +104,9 @@ struct CorrectionStep {
 // value after its slot(p, v)-th update (slot 0 = version 0).
 class LevelSchedule {
  public:
-  static LevelSchedule make(int level, const SynthesisParams& params);
+  // Level `level` of a pyramid of `levels`: the coarsest runs plain passes, the finest uses
+  // params.finest_subpass_size, the others params.subpass_size.
+  static LevelSchedule make(int level, int levels, const SynthesisParams& params);
   const std::vector<CorrectionStep>& steps() const { return steps_; }
   int final_version() const { return int(steps_.size()); }
   int slot(const Voxel& p, int version) const {

@@ -42,7 +42,7 @@ TEST(HistoryWindow, IntersectionIsTheElementwiseMinimum) {
 TEST(LevelSchedule, DualGridStepsSlotsAndBarriers) {
   SynthesisParams p;  // dual-grid, 8 subpasses
   p.passes = 2;       // one grid pass, one dual pass
-  const LevelSchedule fine = LevelSchedule::make(1, p);
+  const LevelSchedule fine = LevelSchedule::make(1, 4, p);
   ASSERT_EQ(fine.final_version(), 16);
   EXPECT_EQ(fine.slot_count(), 3);
   // Class 0 updates at versions 1 and 9; class 7 at 8 and 16.
@@ -58,17 +58,36 @@ TEST(LevelSchedule, DualGridStepsSlotsAndBarriers) {
   EXPECT_EQ(fine.steps()[3].window.version(edge, 1, 0, 0), 0);
   EXPECT_EQ(fine.steps()[12].window.version(edge, 1, 0, 0), 12);   // same dual cell [6, 18)
   EXPECT_EQ(fine.steps()[12].window.version({17, 6, 6}, 1, 0, 0), 8);
-  const LevelSchedule coarse = LevelSchedule::make(0, p);
+  const LevelSchedule coarse = LevelSchedule::make(0, 4, p);
   EXPECT_EQ(coarse.final_version(), 3);
   for (const auto& s : coarse.steps()) EXPECT_FALSE(s.window.has_barrier());
   p.scheme = Scheme::kPlain;
-  EXPECT_EQ(LevelSchedule::make(2, p).final_version(), 2);
+  EXPECT_EQ(LevelSchedule::make(2, 4, p).final_version(), 2);
   // The default single fine pass is the grid pass alone: 8 steps, barrier 0, no dual cells.
-  const LevelSchedule one = LevelSchedule::make(1, SynthesisParams{});
+  const LevelSchedule one = LevelSchedule::make(1, 4, SynthesisParams{});
   ASSERT_EQ(one.final_version(), 8);
   EXPECT_EQ(one.slot_count(), 2);
   EXPECT_EQ(one.steps()[7].window.version(edge, 1, 0, 0), 0);
   EXPECT_EQ(one.steps()[7].window.version(edge, -1, 0, 0), 7);
+}
+
+// The finest level runs finest_subpass_size: by default one step per pass updating every voxel
+// from version 0 (a cut's finest voxels need no chain of earlier subpasses); with 2, the
+// other levels' 8 subpasses. A one-level pyramid's only level is the coarsest: plain.
+TEST(LevelSchedule, TheFinestLevelTakesItsOwnSubpassSize) {
+  SynthesisParams p;
+  const LevelSchedule finest = LevelSchedule::make(3, 4, p);
+  ASSERT_EQ(finest.final_version(), 1);
+  EXPECT_EQ(finest.subpass_size(), 1);
+  EXPECT_TRUE(finest.steps()[0].updates.contains({1, 0, 1}));
+  for (int dx : {-4, 0, 4}) EXPECT_EQ(finest.steps()[0].window.version({11, 11, 11}, dx, 0, 0), 0);
+  EXPECT_EQ(LevelSchedule::make(2, 4, p).final_version(), 8);
+  p.passes = 2;
+  EXPECT_EQ(LevelSchedule::make(3, 4, p).final_version(), 2);
+  p.finest_subpass_size = 2;
+  EXPECT_EQ(LevelSchedule::make(3, 4, p).final_version(), 16);
+  EXPECT_EQ(LevelSchedule::make(3, 4, p).subpass_size(), 2);
+  EXPECT_EQ(LevelSchedule::make(0, 1, p).subpass_size(), 1);
 }
 
 TEST(NeighbourSlots, EqualTheSchedulesSlotOfTheWindowsVersionForEveryOffset) {
@@ -79,7 +98,7 @@ TEST(NeighbourSlots, EqualTheSchedulesSlotOfTheWindowsVersionForEveryOffset) {
     params.passes = 3;
     params.cell_size = 6;  // small cells: the +-8 offsets cross several barriers
     for (int level : {0, 2}) {
-      const LevelSchedule sch = LevelSchedule::make(level, params);
+      const LevelSchedule sch = LevelSchedule::make(level, 4, params);
       for (const Voxel p : {Voxel{0, 0, 0}, Voxel{5, -1, 7}, Voxel{-13, 22, 3}, Voxel{11, 6, -6}})
         for (const CorrectionStep& step : sch.steps()) {
           const HistoryWindow::Resolved w = step.window.resolve(p);

@@ -61,6 +61,7 @@ Status SynthesisParams::validate() const {
   SOLIDTEX_RETURN_IF_ERROR(range(coarse_passes, 0, 8, "coarse_passes"));
   SOLIDTEX_RETURN_IF_ERROR(range(passes, 0, 8, "passes"));
   SOLIDTEX_RETURN_IF_ERROR(range(subpass_size, 1, 2, "subpass_size"));
+  SOLIDTEX_RETURN_IF_ERROR(range(finest_subpass_size, 1, 2, "finest_subpass_size"));
   SOLIDTEX_RETURN_IF_ERROR(range(cell_size, 4, 64, "cell_size"));
   SOLIDTEX_RETURN_IF_ERROR(range(init_subpart, 8, 256, "init_subpart"));
   if (init_subpart % 2) return Status(StatusCode::kInvalidArgument, "must be even", "init_subpart");

@@ -302,7 +302,7 @@ Result<std::shared_ptr<Synthesizer>> Synthesizer::create(std::shared_ptr<const T
   SOLIDTEX_ASSIGN_OR_RETURN(s->impl_->stencils, FrameStencils::make(*s->field_, s->table_->params().neighborhood, L,
                                                                     params.trilinear_levels));
   for (int l = 0; l < L; ++l) {
-    s->schedules_.push_back(LevelSchedule::make(l, params));
+    s->schedules_.push_back(LevelSchedule::make(l, L, params));
     s->impl_->contexts.push_back(CorrectionContext::make(*s->table_, PyramidLevel{l}, params));
   }
   return s;
@@ -317,7 +317,7 @@ Result<std::vector<int>> Synthesizer::spread(LatchedInterrupter& interrupter) co
   if (impl_->stencils.constant()) {
     const SynthesisParams& p = params_;
     key = std::string(scheme_name(p.scheme)) + "/" + std::to_string(p.coarse_passes) + "/" + std::to_string(p.passes) +
-          "/" + std::to_string(p.subpass_size) + "/" + std::to_string(p.cell_size) + "/" +
+          "/" + std::to_string(p.subpass_size) + "/" + std::to_string(p.finest_subpass_size) + "/" + std::to_string(p.cell_size) + "/" +
           std::to_string(p.trilinear_levels) + "/" + std::to_string(table_->params().neighborhood) + "/" +
           std::to_string(table_->levels()) + "/" + field_->describe();
     std::lock_guard<std::mutex> m(memo_mutex);

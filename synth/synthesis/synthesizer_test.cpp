@@ -117,22 +117,31 @@ TEST_F(SynthesizerTest, ThreadsCacheStateAndPiecesDoNotChangeBits) {
 
 TEST_F(SynthesizerTest, NeighbouringCutFindsItsVoxelsFinalInTheCacheWithTheSameBits) {
   // A cut caches every voxel whose value is final, not only its own: with one pass, every voxel
-  // a correction produced. The cut at z + 2 (z + 1 has the other subpass parity, which the
-  // corrections of z ran before) then finds most of itself in the cache (measured: 300 of 400
-  // finest voxels), and what it finds must equal a cold synthesizer's values bit for bit.
-  for (const int passes : {1, 2}) {
-    SynthesisParams p = small_params();
-    p.passes = passes;
-    auto warm = make(table_, "quat:0.9,0.1,0.3,0.2", p);
-    cut(*warm, 'z', 2, 0, 0, 20, 20);
-    SynthesisStats st;
-    const auto next = cut(*warm, 'z', 4, 0, 0, 20, 20, &st);
-    const LevelStats& finest = st.levels.back();
-    RecordProperty("finest_hits_passes_" + std::to_string(passes), std::to_string(finest.cache_hits));
-    if (passes == 1) EXPECT_GT(finest.cache_hits, finest.needed_final / 4) << "the cut next door reused little";
-    auto cold = make(table_, "quat:0.9,0.1,0.3,0.2", p, 0);
-    EXPECT_EQ(next, cut(*cold, 'z', 4, 0, 0, 20, 20)) << passes << " passes";
-  }
+  // a correction produced. With 8 finest subpasses, the cut at z + 2 (z + 1 has the other
+  // subpass parity, which the corrections of z ran before) then finds most of its finest voxels
+  // in the cache (measured: 300 of 400). With one finest step (the default) the finest voxels
+  // of a cut depend on the upsampled level only, and the cut at z + 1 finds most of the next
+  // coarser level's final voxels in the cache. What is found must equal a cold synthesizer's
+  // values bit for bit.
+  for (const int finest_s : {1, 2})
+    for (const int passes : {1, 2}) {
+      SynthesisParams p = small_params();
+      p.passes = passes;
+      p.finest_subpass_size = finest_s;
+      const int next_at = finest_s == 1 ? 3 : 4;
+      auto warm = make(table_, "quat:0.9,0.1,0.3,0.2", p);
+      cut(*warm, 'z', 2, 0, 0, 20, 20);
+      SynthesisStats st;
+      const auto next = cut(*warm, 'z', next_at, 0, 0, 20, 20, &st);
+      const LevelStats& reused = finest_s == 1 ? st.levels[st.levels.size() - 2] : st.levels.back();
+      RecordProperty("hits_finest_s" + std::to_string(finest_s) + "_passes_" + std::to_string(passes),
+                     std::to_string(reused.cache_hits));
+      if (passes == 1 || finest_s == 1)
+        EXPECT_GT(reused.cache_hits, reused.needed_final / (finest_s == 1 ? 2 : 4))
+            << "the cut next door reused little (finest s " << finest_s << ", " << passes << " passes)";
+      auto cold = make(table_, "quat:0.9,0.1,0.3,0.2", p, 0);
+      EXPECT_EQ(next, cut(*cold, 'z', next_at, 0, 0, 20, 20)) << passes << " passes, finest s " << finest_s;
+    }
 }
 
 TEST_F(SynthesizerTest, TinyCacheBudgetEvictsBricksAndKeepsResults) {
@@ -224,6 +233,7 @@ TEST_F(SynthesizerTest, StretchedFieldsReadBeyondTheNeighborhoodBricks) {
 TEST_F(SynthesizerTest, DualGridNeedsFarFewerVoxelsThanPlainSubpasses) {
   SynthesisParams p = small_params(Scheme::kSubpass);
   p.passes = 2;
+  p.finest_subpass_size = 2;  // the schemes differ in how subpasses read across cells
   p.cell_size = 8;
   SynthesisStats plain, dual;
   cut(*make(table_, "identity", p, 0), 'z', 0, 0, 0, 32, 32, &plain);
@@ -257,6 +267,7 @@ TEST_F(SynthesizerTest, CorrectionLowersMatchingEnergyAndDualGridKeepsQuality) {
       SynthesisParams p = small_params(scheme);
       p.typicality = 0.f;
       p.color = ColorRule::kMean;
+      p.finest_subpass_size = 2;  // the schemes' subpasses, as Zhang compares them
       p.init = init;
       return p;
     };

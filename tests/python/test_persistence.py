@@ -92,29 +92,35 @@ def test_sigterm_exits_cleanly_and_restarts(server, exemplars):
 
 def test_volumes_stored_before_a_default_changed_keep_their_voxels(server, exemplars):
     """New volumes pin the appearance-changing defaults they were made with (typicality, fine
-    passes, init, color); a volume.json written before those were pinned (none anywhere) comes
-    back with the values its voxels were synthesized with (typicality 0, two passes, slab init,
-    mean colors), one written when only typicality and passes were pinned comes back with slab
-    init and mean colors, and one written before color was pinned with mean colors: no release
-    changes a stored volume's look."""
+    passes, init, color, finest_subpass_size); a volume.json written before those were pinned
+    (none anywhere) comes back with the values its voxels were synthesized with (typicality 0,
+    two passes, slab init, mean colors, 8 finest subpasses), and one written at each later era
+    (typicality and passes pinned; then init; then color) with the older values of the keys it
+    lacks: no release changes a stored volume's look."""
     a = server()
     c = a.client
     ex = upload_ready(c, exemplars["spots"])
     vol = c.create_volume(exemplar=ex["id"], seed=4)
-    assert vol["params"] == {"typicality": 0.5, "passes": 1, "init": "auto", "color": "medoid"}, vol
-    legacy = c.create_volume(exemplar=ex["id"], seed=4, params={"typicality": 0, "passes": 2, "init": "slab", "color": "mean"})
+    assert vol["params"] == {"typicality": 0.5, "passes": 1, "init": "auto", "color": "medoid", "finest_subpass_size": 1}, vol
+    legacy = c.create_volume(exemplar=ex["id"], seed=4, params={"typicality": 0, "passes": 2, "init": "slab", "color": "mean",
+                                                                    "finest_subpass_size": 2})
     want = c.slice(legacy["id"], "z", 2, (24, 24))
     assert not np.array_equal(c.slice(vol["id"], "z", 2, (24, 24)), want), "the defaults changed nothing"
     # made when typicality and passes were pinned but init was not
     middle = c.create_volume(exemplar=ex["id"], seed=5)
-    slab = c.create_volume(exemplar=ex["id"], seed=5, params={"init": "slab", "color": "mean"})
+    slab = c.create_volume(exemplar=ex["id"], seed=5, params={"init": "slab", "color": "mean", "finest_subpass_size": 2})
     want_middle = c.slice(slab["id"], "z", 2, (24, 24))
     assert not np.array_equal(c.slice(middle["id"], "z", 2, (24, 24)), want_middle), "init changed nothing"
     # made when init was pinned but color was not
     late = c.create_volume(exemplar=ex["id"], seed=6)
-    mean = c.create_volume(exemplar=ex["id"], seed=6, params={"color": "mean"})
+    mean = c.create_volume(exemplar=ex["id"], seed=6, params={"color": "mean", "finest_subpass_size": 2})
     want_late = c.slice(mean["id"], "z", 2, (24, 24))
     assert not np.array_equal(c.slice(late["id"], "z", 2, (24, 24)), want_late), "color changed nothing"
+    # made when color was pinned but finest_subpass_size was not
+    recent = c.create_volume(exemplar=ex["id"], seed=7)
+    eight = c.create_volume(exemplar=ex["id"], seed=7, params={"finest_subpass_size": 2})
+    want_recent = c.slice(eight["id"], "z", 2, (24, 24))
+    assert not np.array_equal(c.slice(recent["id"], "z", 2, (24, 24)), want_recent), "subpasses changed nothing"
     assert a.stop(grace=10) == 0
     path = next(p for p in a.data_dir.rglob("volume.json") if vol["id"] in str(p))
     info = json.loads(path.read_text())
@@ -123,20 +129,28 @@ def test_volumes_stored_before_a_default_changed_keep_their_voxels(server, exemp
     path = next(p for p in a.data_dir.rglob("volume.json") if middle["id"] in str(p))
     info = json.loads(path.read_text())
     for params in (info["params"], info["spec"]["params"]):
-        del params["init"], params["color"]
+        del params["init"], params["color"], params["finest_subpass_size"]
     path.write_text(json.dumps(info))
     path = next(p for p in a.data_dir.rglob("volume.json") if late["id"] in str(p))
     info = json.loads(path.read_text())
     for params in (info["params"], info["spec"]["params"]):
-        del params["color"]
+        del params["color"], params["finest_subpass_size"]
+    path.write_text(json.dumps(info))
+    path = next(p for p in a.data_dir.rglob("volume.json") if recent["id"] in str(p))
+    info = json.loads(path.read_text())
+    for params in (info["params"], info["spec"]["params"]):
+        del params["finest_subpass_size"]
     path.write_text(json.dumps(info))
     b = server(data_dir=a.data_dir)
     got = b.client.get_volume(vol["id"])
-    assert got["params"] == {"typicality": 0, "passes": 2, "init": "slab", "color": "mean"}, got
+    assert got["params"] == {"typicality": 0, "passes": 2, "init": "slab", "color": "mean", "finest_subpass_size": 2}, got
     assert np.array_equal(b.client.slice(vol["id"], "z", 2, (24, 24)), want)
     got = b.client.get_volume(middle["id"])
-    assert got["params"] == {"typicality": 0.5, "passes": 1, "init": "slab", "color": "mean"}, got
+    assert got["params"] == {"typicality": 0.5, "passes": 1, "init": "slab", "color": "mean", "finest_subpass_size": 2}, got
     assert np.array_equal(b.client.slice(middle["id"], "z", 2, (24, 24)), want_middle)
     got = b.client.get_volume(late["id"])
-    assert got["params"] == {"typicality": 0.5, "passes": 1, "init": "auto", "color": "mean"}, got
+    assert got["params"] == {"typicality": 0.5, "passes": 1, "init": "auto", "color": "mean", "finest_subpass_size": 2}, got
     assert np.array_equal(b.client.slice(late["id"], "z", 2, (24, 24)), want_late)
+    got = b.client.get_volume(recent["id"])
+    assert got["params"] == {"typicality": 0.5, "passes": 1, "init": "auto", "color": "medoid", "finest_subpass_size": 2}, got
+    assert np.array_equal(b.client.slice(recent["id"], "z", 2, (24, 24)), want_recent)

@@ -112,6 +112,25 @@ def test_init_takes_its_three_names_only(srv):
     alive(srv)
 
 
+def test_finest_subpass_size_takes_1_and_2_only(srv):
+    # both ends of the documented range synthesize and differ; the default 1 is pinned when
+    # absent; anything else is a 400 naming the field
+    cuts = {}
+    for value in (1, 2):
+        r = create_volume(srv, params={"finest_subpass_size": value})
+        assert r.status_code == 201, r.text
+        assert r.json()["params"]["finest_subpass_size"] == value
+        got = slice_of(srv, r.json()["id"], size="8,8")
+        assert got.status_code == 200, got.text
+        cuts[value] = got.content
+    assert cuts[1] != cuts[2]
+    assert create_volume(srv).json()["params"]["finest_subpass_size"] == 1
+    for value in (0, 3, -1, 1.5, "1", None, [1]):
+        assert_error(create_volume(srv, params={"finest_subpass_size": value}), 400, "invalid_argument",
+                     "params.finest_subpass_size")
+    alive(srv)
+
+
 def test_color_takes_its_two_names_only(srv):
     # medoid (the default, pinned when absent) and mean synthesize the same triples and differ
     # in colors only; anything else is a 400 naming the field
