@@ -54,6 +54,18 @@ E = {"400": err("Malformed request: bad JSON, unknown key or query parameter, va
      "429": err("Too many concurrent analysis jobs (--max-jobs)."), "503": err("Worker queue full (see Retry-After) or shutting down."),
      "504": err("The request's deadline passed; the work was cancelled.")}
 def errs(*codes): return {c: E[c] for c in codes}
+# Chunked-array views (server/chunked_arrays.h): every answer carries CORS headers.
+CORS = {"Access-Control-Allow-Origin": {"schema": {"type": "string"}}, "Access-Control-Expose-Headers": {"schema": {"type": "string"}}}
+ZARR_META = {"description": "Metadata (JSON).", "headers": {**CORS, "ETag": {"schema": {"type": "string"}}, "Cache-Control": {"schema": {"type": "string"}}},
+             "content": {"application/json": {"schema": {"type": "object"}}}}
+ZARR_CHUNK_OUT = {"description": "zstd-compressed chunk bytes; a strong ETag from (volume spec, format, dataset, chunk), stable across restarts; Cache-Control: public, max-age=31536000, immutable.",
+                  "headers": {**CORS, "ETag": {"schema": {"type": "string"}}, "Cache-Control": {"schema": {"type": "string"}}, "X-Voxels-Synthesized": {"schema": {"type": "integer"}}},
+                  "content": {"application/octet-stream": {"schema": {"type": "string", "format": "binary"}}}}
+def zarr_index(name, desc):
+    return {"name": name, "in": "path", "required": True, "description": desc + " Past the array (or not an index): 404.", "schema": {"type": "integer", "minimum": 0}}
+ZARR_SCALE = zarr_index("scale", "Dataset: 0 is the finest synthesis level, s has voxels 2^s finest voxels wide.")
+ZARR_CHUNK = [zarr_index("c", "Channel chunk: always 0 (the 3 channels are one chunk)."), zarr_index("cz", "Chunk index along z."),
+              zarr_index("cy", "Chunk index along y."), zarr_index("cx", "Chunk index along x.")]
 def created(schema, links):
     return {"description": "Created.", "headers": {"Location": {"schema": {"type": "string"}}},
             "content": {"application/json": {"schema": schema}}, "links": links}
@@ -296,6 +308,23 @@ paths = {
    "post": {"operationId": "field_from_mesh", "summary": "Solve a frame field from a stored mesh's geometry: principal-curvature frames or crest-line curves as soft constraints (harmonic interpolation, like sketches). The field's domain is the placed mesh's box (world units), so a volume using it should place the mesh the same way. A mesh without usable feature curves is refused (422).", "parameters": [timeout],
      "requestBody": {"required": True, "content": {"application/json": {"schema": ref("FieldFromMesh")}}},
      "responses": {"201": created(ref("Field"), links_to(FIELD_OPS)), **errs("400", "404", "413", "415", "422", "503", "504")}}},
+ "/v1/volumes/{id}/zarr/zarr.json": {"parameters": [pid()],
+   "get": {"operationId": "zarr_group", "summary": "OME-Zarr 0.5 (Zarr v3) group of the volume: `attributes.ome.multiscales` with one dataset per synthesis level (dataset s = synthesis level L-1-s, scale 2^s; levels are synthesis levels, not box filters; region volumes serve the finest only) and inline consolidated metadata. The arrays are [c, z, y, x] uint8 sRGB windows of --array-extent^3 finest voxels from the origin, chunks [3, 32, 32, 32], zstd. Open it with zarr-python: `zarr.open_group(URL, mode='r')`.",
+     "responses": {"200": ZARR_META, **errs("400", "404", "503")}}},
+ "/v1/volumes/{id}/zarr/{scale}/zarr.json": {"parameters": [pid(), ZARR_SCALE],
+   "get": {"operationId": "zarr_array", "summary": "Zarr v3 array metadata of dataset `scale`.", "responses": {"200": ZARR_META, **errs("400", "404", "503")}}},
+ "/v1/volumes/{id}/zarr/{scale}/c/{c}/{cz}/{cy}/{cx}": {"parameters": [pid(), ZARR_SCALE, *ZARR_CHUNK],
+   "get": {"operationId": "zarr_chunk", "summary": "One chunk (default chunk-key encoding), synthesized when first asked for: zstd-compressed bytes of a C-order (c, z, y, x) uint8 block, exactly the region endpoint's sRGB voxels of that box at that level. Never 404 for voxels not computed yet; 404 only outside the array.",
+     "responses": {"200": ZARR_CHUNK_OUT, **errs("400", "404", "422", "503", "504")}}},
+ "/v1/volumes/{id}/zarr2/.zgroup": {"parameters": [pid()],
+   "get": {"operationId": "zarr2_group", "summary": "Zarr v2 group of the volume (OME-Zarr 0.4 mirror of /zarr).", "responses": {"200": ZARR_META, **errs("400", "404", "503")}}},
+ "/v1/volumes/{id}/zarr2/.zattrs": {"parameters": [pid()],
+   "get": {"operationId": "zarr2_attributes", "summary": "OME-Zarr 0.4 multiscales of the Zarr v2 group.", "responses": {"200": ZARR_META, **errs("400", "404", "503")}}},
+ "/v1/volumes/{id}/zarr2/{scale}/.zarray": {"parameters": [pid(), ZARR_SCALE],
+   "get": {"operationId": "zarr2_array", "summary": "Zarr v2 array metadata of dataset `scale` (dimension separator '/', compressor zstd).", "responses": {"200": ZARR_META, **errs("400", "404", "503")}}},
+ "/v1/volumes/{id}/zarr2/{scale}/{c}/{cz}/{cy}/{cx}": {"parameters": [pid(), ZARR_SCALE, *ZARR_CHUNK],
+   "get": {"operationId": "zarr2_chunk", "summary": "One Zarr v2 chunk: the same bytes as the Zarr v3 chunk at the same indices.",
+     "responses": {"200": ZARR_CHUNK_OUT, **errs("400", "404", "422", "503", "504")}}},
  "/v1/volumes/{id}/stats": {"parameters": [pid()],
    "get": {"operationId": "volume_stats", "summary": "Voxels per level, cache bytes and hits, the loaded state's resident bytes and evictions, the last requests' dependent-set sizes.", "responses": {"200": js(ref("Stats")), **errs("404")}}},
 }

@@ -196,9 +196,9 @@ auto Api::interruptible(const HttpRequest& r, const std::optional<std::string>& 
 }
 
 Result<QueryResult> Api::query_volume(const HttpRequest& r, const std::string& kind, const TargetSet& target,
-                                      const std::optional<std::string>& timeout) {
+                                      const std::optional<std::string>& timeout, int level) {
   return interruptible(r, timeout, "the " + kind,
-                       [&](Interrupter& i) { return volumes_.query(r.param("id"), kind, target, i); });
+                       [&](Interrupter& i) { return volumes_.query(r.param("id"), kind, target, i, level); });
 }
 
 HttpResponse Api::healthz(const HttpRequest& r) {

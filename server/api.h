@@ -6,10 +6,12 @@
 #pragma once
 
 #include <atomic>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
 
+#include "chunked_arrays.h"
 #include "exemplar_service.h"
 #include "field_service.h"
 #include "http_types.h"
@@ -58,6 +60,14 @@ class Api {
   HttpResponse get_mesh_file(const HttpRequest& r);
   HttpResponse surface(const HttpRequest& r);
   HttpResponse field_from_mesh(const HttpRequest& r);
+  // Chunked-array views (api_arrays.cpp, chunked_arrays.h).
+  HttpResponse zarr_group(const HttpRequest& r);
+  HttpResponse zarr_array(const HttpRequest& r);
+  HttpResponse zarr_chunk(const HttpRequest& r);
+  HttpResponse zarr2_group(const HttpRequest& r);
+  HttpResponse zarr2_attributes(const HttpRequest& r);
+  HttpResponse zarr2_array(const HttpRequest& r);
+  HttpResponse zarr2_chunk(const HttpRequest& r);
 
  private:
   Result<std::unique_ptr<RequestInterrupter>> interrupter_for(const HttpRequest& r, const std::optional<std::string>& timeout) const;
@@ -66,9 +76,18 @@ class Api {
   template <typename F>
   auto interruptible(const HttpRequest& r, const std::optional<std::string>& timeout, const std::string& what, F&& work)
       -> decltype(work(std::declval<Interrupter&>()));
-  // A volume query (kind: slice, cut, region, points, surface) under the request's deadline.
+  // A volume query (kind: slice, cut, region, points, surface, chunk) under the request's
+  // deadline; `level` as in VolumeService::query.
   Result<QueryResult> query_volume(const HttpRequest& r, const std::string& kind, const TargetSet& target,
-                                   const std::optional<std::string>& timeout);
+                                   const std::optional<std::string>& timeout, int level = -1);
+  struct ArrayView {
+    ArrayWindow window;
+    std::string tag;  // VolumeService::ArrayInfo::tag
+  };
+  Result<ArrayView> array_view(const HttpRequest& r);
+  Result<int> dataset_of(const HttpRequest& r, const ArrayView& view);
+  HttpResponse array_chunk(const HttpRequest& r, const std::string& format);  // the same bytes in every format
+  HttpResponse array_metadata(const HttpRequest& r, const std::function<Result<nlohmann::json>(const ArrayView&)>& make);
   Result<HttpResponse> synthesize_image(const HttpRequest& r, const std::string& kind, const TargetSet& target,
                                         const std::optional<std::string>& timeout);
 

@@ -37,6 +37,13 @@ const std::vector<Route>& route_table() {
       {"GET", "/v1/meshes/{id}/file", E::kWorker, &Api::get_mesh_file},
       {"POST", "/v1/volumes/{id}/surface", E::kWorker, &Api::surface},
       {"POST", "/v1/fields/from-mesh", E::kWorker, &Api::field_from_mesh},
+      {"GET", "/v1/volumes/{id}/zarr/zarr.json", E::kWorker, &Api::zarr_group},
+      {"GET", "/v1/volumes/{id}/zarr/{scale}/zarr.json", E::kWorker, &Api::zarr_array},
+      {"GET", "/v1/volumes/{id}/zarr/{scale}/c/{c}/{cz}/{cy}/{cx}", E::kWorker, &Api::zarr_chunk},
+      {"GET", "/v1/volumes/{id}/zarr2/.zgroup", E::kWorker, &Api::zarr2_group},
+      {"GET", "/v1/volumes/{id}/zarr2/.zattrs", E::kWorker, &Api::zarr2_attributes},
+      {"GET", "/v1/volumes/{id}/zarr2/{scale}/.zarray", E::kWorker, &Api::zarr2_array},
+      {"GET", "/v1/volumes/{id}/zarr2/{scale}/{c}/{cz}/{cy}/{cx}", E::kWorker, &Api::zarr2_chunk},
   };
   return routes;
 }

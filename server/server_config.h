@@ -37,6 +37,9 @@ struct ServerConfig {
   MeshLimits mesh_limits;           // vertex and face counts per mesh: 422 beyond
   int max_jobs = 4;                 // analysis jobs queued or running, [1, 1000]; beyond: 429
   int analysis_threads = 1;         // analyses run at once, [1, 16]
+  // Side of the chunked-array views (/zarr, /zarr2) in finest voxels from the origin, a
+  // multiple of 32 in [32, 2^20]: the window on the unbounded volume those clients see.
+  int64_t array_extent = 1024;
 
   Status validate() const;
 };

@@ -635,9 +635,29 @@ Status VolumeService::check_target_size(int64_t samples, const std::string& fiel
   return Status::ok();
 }
 
+Result<VolumeService::ArrayInfo> VolumeService::array_info(const std::string& id) {
+  SOLIDTEX_ASSIGN_OR_RETURN(auto v, impl_->find(id));
+  SOLIDTEX_ASSIGN_OR_RETURN(std::shared_ptr<VolumeState> state, impl_->acquire(v));
+  struct Release {
+    Impl& impl;
+    Volume& v;
+    ~Release() { impl.release(v); }
+  } release{*impl_, *v};
+  ArrayInfo out;
+  out.levels = state->regions ? 1 : state->synths[0]->table().levels();
+  uint64_t h = 0xcbf29ce484222325ull;  // FNV-1a of the spec's canonical dump (sorted keys)
+  for (const char c : v->info["spec"].dump()) h = (h ^ uint8_t(c)) * 0x100000001b3ull;
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
+  out.tag = hex;
+  return out;
+}
+
 Result<QueryResult> VolumeService::query(const std::string& id, const std::string& kind, const TargetSet& target,
-                                         Interrupter& interrupter) {
-  SOLIDTEX_RETURN_IF_ERROR(check_target_size(int64_t(target.sample.size()), "size"));
+                                         Interrupter& interrupter, int level) {
+  // --max-voxels bounds the sizes clients choose; a chunk of the array views is their fixed
+  // 32^3 unit (still bounded by --max-request-mb), which every array client must be able to read.
+  if (kind != "chunk") SOLIDTEX_RETURN_IF_ERROR(check_target_size(int64_t(target.sample.size()), "size"));
   SOLIDTEX_ASSIGN_OR_RETURN(auto v, impl_->find(id));
   SOLIDTEX_ASSIGN_OR_RETURN(std::shared_ptr<VolumeState> state, impl_->acquire(v));
   struct Release {
@@ -650,6 +670,8 @@ Result<QueryResult> VolumeService::query(const std::string& id, const std::strin
   QueryResult out;
   SynthesisOptions options;
   options.max_bytes = impl_->config.max_request_bytes;
+  options.level = level;
+  if (state->regions && level >= 0) return Status(StatusCode::kNotFound, "region volumes serve the finest level only", "level");
   if (state->regions) {
     SOLIDTEX_ASSIGN_OR_RETURN(out.rgb, state->regions->synthesize(target, interrupter, &per_region, options));
   } else {

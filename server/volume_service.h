@@ -64,8 +64,18 @@ class VolumeService {
 
   // kUnprocessable when the target has more samples than --max-voxels (checked by callers
   // before building big targets too, see check_target_size).
+  // `level`: the pyramid level of the target's voxels (SynthesisOptions::level; -1 finest).
+  // Kind "chunk" (the array views' fixed 32^3 unit) is not bound by --max-voxels.
   Result<QueryResult> query(const std::string& id, const std::string& kind, const TargetSet& target,
-                            Interrupter& interrupter);
+                            Interrupter& interrupter, int level = -1);
+  // What the chunked-array views need: the synthesis levels served (region volumes serve the
+  // finest only: their labels are defined on finest voxels) and a tag that changes whenever the
+  // volume's voxels could (a hash of its stored spec: exemplars, field, seed, pinned params).
+  struct ArrayInfo {
+    int levels = 1;
+    std::string tag;
+  };
+  Result<ArrayInfo> array_info(const std::string& id);
   Status check_target_size(int64_t samples, const std::string& field) const;
   Result<nlohmann::json> stats(const std::string& id) const;
 

@@ -44,7 +44,7 @@ Result<std::vector<int>> measure_spread(const std::vector<LevelSchedule>& schedu
   const DependencyInputs in{&schedules, &stencils, nullptr};
   // Probes at several phases of the cell and subpass lattices, which bound the spread.
   for (const int o : {0, 3, 5, 13}) {
-    auto deps = analyze_dependencies(in, TargetSet::from_voxels({{o, o, o}}, 1, 1), interrupter);
+    auto deps = analyze_dependencies(in, TargetSet::from_voxels({{o, o, o}}, 1, 1), PyramidLevel{L - 1}, interrupter);
     if (!deps.is_ok()) return deps.status();
     for (int l = 0; l < L; ++l) {
       const LevelDependencies& d = (*deps)[size_t(l)];
@@ -65,7 +65,7 @@ RequestCost estimate_cost(const std::vector<LevelSchedule>& schedules, const Fra
                           const std::vector<int>& spread, const TargetSet& target) {
   RequestCost cost;
   const int L = stencils.levels();
-  const std::vector<VoxelBox> boxes = dependency_boxes(schedules, stencils, target.bounds());
+  const std::vector<VoxelBox> boxes = dependency_boxes(schedules, stencils, target.bounds(), PyramidLevel{L - 1});
   cost.levels.resize(size_t(L));
   // Every set voxel of level l lies within `radius` (its own voxels, per axis) of some target
   // voxel's position on that level: the level's spread plus the finer level's radius halved.
@@ -107,6 +107,7 @@ int64_t store_bytes(const std::vector<LevelSchedule>& schedules, const std::vect
   int64_t peak = 0, previous = 0;
   for (size_t l = 0; l < deps.size(); ++l) {
     const LevelDependencies& d = deps[l];
+    if (d.needed.empty()) continue;  // finer than a coarse target: nothing to store
     // Cache hits may add bricks the version-0 set does not touch: count their distinct bricks.
     const BrickIndex index(d.box);
     std::vector<size_t> hit_bricks;

@@ -389,11 +389,11 @@ std::vector<Voxel> parents_of(const VoxelMask& set, const VoxelBox& parent_box) 
 // Level boxes, finest first: a level's sets stay within its final-version box dilated by the
 // number of steps times the reach; the parents of that box bound the coarser final version.
 std::vector<VoxelBox> dependency_boxes(const std::vector<LevelSchedule>& schedules, const FrameStencils& stencils,
-                                       const VoxelBox& target_bounds) {
+                                       const VoxelBox& target_bounds, PyramidLevel top) {
   const int L = stencils.levels();
   std::vector<VoxelBox> boxes(static_cast<size_t>(L));
   VoxelBox final_box = target_bounds;
-  for (int l = L - 1; l >= 0; --l) {
+  for (int l = top.index; l >= 0; --l) {
     const int radius = schedules[size_t(l)].final_version() * stencils.reach(PyramidLevel{l});
     boxes[size_t(l)] = final_box.dilated(radius);
     const VoxelBox& b = boxes[size_t(l)];
@@ -403,12 +403,13 @@ std::vector<VoxelBox> dependency_boxes(const std::vector<LevelSchedule>& schedul
 }
 
 Result<std::vector<LevelDependencies>> analyze_dependencies(const DependencyInputs& in, const TargetSet& target,
-                                                            LatchedInterrupter& interrupter) {
+                                                            PyramidLevel top, LatchedInterrupter& interrupter) {
   const int L = in.stencils->levels();
-  const std::vector<VoxelBox> boxes = dependency_boxes(*in.schedules, *in.stencils, target.bounds());
+  if (top.index < 0 || top.index >= L) return Status(StatusCode::kInternal, "target level outside the pyramid");
+  const std::vector<VoxelBox> boxes = dependency_boxes(*in.schedules, *in.stencils, target.bounds(), top);
   std::vector<LevelDependencies> deps(static_cast<size_t>(L));
   std::vector<Voxel> final_need = target.voxels;
-  for (int l = L - 1; l >= 0; --l) {
+  for (int l = top.index; l >= 0; --l) {
     const LevelSchedule& sch = (*in.schedules)[size_t(l)];
     const int V = sch.final_version();
     LevelDependencies& dep = deps[size_t(l)];

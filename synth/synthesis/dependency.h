@@ -48,14 +48,16 @@ struct DependencyInputs {
   bool per_voxel = false;       // force the per-voxel path (the reference, for tests/benchmarks)
 };
 
-// The per-level sets for `target` (index = level, coarsest first). Cancelled through
-// `interrupter` between steps.
+// The per-level sets for `target`, whose voxels are final voxels of level `top` (index =
+// level, coarsest first; levels finer than `top` stay empty). Cancelled through `interrupter`
+// between steps.
 Result<std::vector<LevelDependencies>> analyze_dependencies(const DependencyInputs& in, const TargetSet& target,
-                                                            LatchedInterrupter& interrupter);
+                                                            PyramidLevel top, LatchedInterrupter& interrupter);
 
-// The box every set of each level lies in (index = level), from the target's bounds.
+// The box every set of each level up to `top` lies in (index = level), from the bounds of a
+// target on level `top`.
 std::vector<VoxelBox> dependency_boxes(const std::vector<LevelSchedule>& schedules, const FrameStencils& stencils,
-                                       const VoxelBox& target_bounds);
+                                       const VoxelBox& target_bounds, PyramidLevel top);
 
 // The parent (one level coarser) of voxel p.
 inline Voxel parent_of(const Voxel& p) { return {floor_div(p.x, 2), floor_div(p.y, 2), floor_div(p.z, 2)}; }

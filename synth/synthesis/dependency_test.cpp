@@ -34,7 +34,7 @@ std::vector<LevelDependencies> analyze(const Inputs& s, const TargetSet& t, Voxe
   DependencyInputs in{&s.schedules, &s.stencils, cache};
   in.per_voxel = per_voxel;
   LatchedInterrupter stop(null_interrupter());
-  auto r = analyze_dependencies(in, t, stop);
+  auto r = analyze_dependencies(in, t, PyramidLevel{s.stencils.levels() - 1}, stop);
   EXPECT_TRUE(r.is_ok()) << r.status().to_string();
   return r.is_ok() ? std::move(*r) : std::vector<LevelDependencies>{};
 }

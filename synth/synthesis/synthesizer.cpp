@@ -348,7 +348,9 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize_piece(const Ta
                                                                         LatchedInterrupter& poller, SynthesisStats& stats,
                                                                         const SynthesisOptions& options) {
   const int L = table_->levels();
+  const PyramidLevel top{options.level < 0 ? L - 1 : options.level};
   if (options.max_bytes > 0) {
+    // The estimate treats the target as finest voxels: an upper bound for coarser targets.
     SOLIDTEX_ASSIGN_OR_RETURN(const std::vector<int> spread, this->spread(poller));
     const RequestCost cost = estimate_cost(schedules_, impl_->stencils, spread, target);
     stats.estimated_bytes = cost.bytes;
@@ -358,8 +360,8 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize_piece(const Ta
   // Backwards: what the target depends on.
   const auto t_dep = Clock::now();
   const DependencyInputs inputs{&schedules_, &impl_->stencils, options.use_cache ? cache_.get() : nullptr};
-  SOLIDTEX_ASSIGN_OR_RETURN(const std::vector<LevelDependencies> deps, analyze_dependencies(inputs, target, poller));
-  for (int l = 0; l < L; ++l) {
+  SOLIDTEX_ASSIGN_OR_RETURN(const std::vector<LevelDependencies> deps, analyze_dependencies(inputs, target, top, poller));
+  for (int l = 0; l <= top.index; ++l) {
     LevelStats& ls = stats.levels[size_t(l)];
     ls.level = l;
     ls.needed_final = deps[size_t(l)].needed_final;
@@ -377,7 +379,7 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize_piece(const Ta
   // Forwards, coarsest level first, inside the sets.
   SetChecks checks(options.instrument);
   std::unique_ptr<LevelStore> parent;
-  for (int l = 0; l < L; ++l) {
+  for (int l = 0; l <= top.index; ++l) {
     const auto t_level = Clock::now();
     const PyramidLevel level{l};
     const LevelDependencies& dep = deps[size_t(l)];
@@ -395,10 +397,9 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize_piece(const Ta
     parent = std::move(store);
   }
 
-  // Output colors of the finest level's final versions.
-  const PyramidLevel finest{L - 1};
-  const LevelSchedule& fsch = schedules_[size_t(finest.index)];
-  const CorrectionContext& fctx = impl_->contexts[size_t(finest.index)];
+  // Output colors of the target level's final versions.
+  const LevelSchedule& fsch = schedules_[size_t(top.index)];
+  const CorrectionContext& fctx = impl_->contexts[size_t(top.index)];
   std::vector<std::array<float, 3>> voxel_rgb(target.voxels.size());
   for (size_t i = 0; i < target.voxels.size(); ++i) {
     const Voxel& p = target.voxels[i];
@@ -406,7 +407,7 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize_piece(const Ta
     checks.read(*parent, p, slot);
     output_color(*table_, parent->triple(p, slot), fctx.color_weights, fctx.color_rule, voxel_rgb[i].data());
   }
-  checks.count_unread(fsch, deps[size_t(finest.index)], *parent);
+  checks.count_unread(fsch, deps[size_t(top.index)], *parent);
   stats.unsound_reads = checks.unsound();
   stats.unread_required = checks.unread();
   return voxel_rgb;
@@ -418,6 +419,9 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize(const TargetSe
   const auto t_start = Clock::now();
   if (target.voxels.empty()) return Status(StatusCode::kInvalidArgument, "the request selects no voxels", "target");
   const int L = table_->levels();
+  if (options.level < -1 || options.level >= L)
+    return Status(StatusCode::kInvalidArgument,
+                  "is " + std::to_string(options.level) + "; the pyramid has levels 0.." + std::to_string(L - 1), "level");
   SynthesisStats stats;
   stats.levels.resize(size_t(L));
   LatchedInterrupter poller(interrupter);

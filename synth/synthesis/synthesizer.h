@@ -61,6 +61,11 @@ struct SynthesisOptions {
   // (cost_model.h) or whose computed sets need more is refused with kUnprocessable before
   // anything that size is allocated.
   int64_t max_bytes = 0;
+  // The pyramid level the target's voxels lie on: -1 (default) is the finest; a coarser level
+  // (0 = coarsest) gives that level's final voxels and synthesizes nothing finer. Their colors
+  // are output colors of the level's triples (synthesis levels, not box-filtered finest voxels);
+  // by purity they equal what any request reaching that level computes.
+  int level = -1;
 };
 
 struct RequestCost;

@@ -8,6 +8,7 @@
 
 #include "analysis/analysis.h"
 #include "testkit/quality.h"
+#include "synthesis/correction.h"
 #include "synthesis/pyramid_init.h"
 #include "synthesis/region_volume.h"
 #include "testkit/test_support.h"
@@ -142,6 +143,50 @@ TEST_F(SynthesizerTest, NeighbouringCutFindsItsVoxelsFinalInTheCacheWithTheSameB
       auto cold = make(table_, "quat:0.9,0.1,0.3,0.2", p, 0);
       EXPECT_EQ(next, cut(*cold, 'z', next_at, 0, 0, 20, 20)) << passes << " passes, finest s " << finest_s;
     }
+}
+
+// Targets on a coarser level: their colors are the output colors of the level's final triples,
+// the same triples a finest-level request computes on the way (found in its cache), and asking
+// for them first changes no finest voxel. Levels outside the pyramid are errors naming `level`.
+TEST_F(SynthesizerTest, CoarseLevelTargetsAreThatLevelsFinalVoxels) {
+  const SynthesisParams p = small_params();
+  const int L = table_->levels();
+  auto fine_first = make(table_, "quat:0.9,0.1,0.3,0.2", p);
+  const auto finest = cut(*fine_first, 'z', 0, 0, 0, 16, 16);
+  // Level L-2 voxels under the cut's centre: parents of finest voxels (4..11, 4..11, 0).
+  std::vector<Voxel> coarse;
+  for (int y = 2; y < 6; ++y)
+    for (int x = 2; x < 6; ++x) coarse.push_back({x, y, 0});
+  std::vector<CoordinateTriple> triples;
+  std::vector<uint8_t> found;
+  ASSERT_EQ(fine_first->cache().lookup(PyramidLevel{L - 2}, coarse, triples, found), int64_t(coarse.size()));
+  const CorrectionContext ctx = CorrectionContext::make(*table_, PyramidLevel{L - 2}, p);
+  for (const int level : {L - 2, 0}) {
+    auto coarse_first = make(table_, "quat:0.9,0.1,0.3,0.2", p);
+    SynthesisOptions o;
+    o.level = level;
+    o.max_bytes = int64_t(1) << 30;  // the memory checks walk every level's sets
+    SynthesisStats st;
+    auto got = coarse_first->synthesize(TargetSet::box({2, 2, 0}, 4, 4, 1).value(), null_interrupter(), &st, o);
+    ASSERT_TRUE(got.is_ok()) << got.status().to_string();
+    ASSERT_EQ(got->size(), coarse.size());
+    for (int l = level + 1; l < L; ++l) EXPECT_EQ(st.levels[size_t(l)].voxels, 0) << "level " << l << " was synthesized";
+    if (level == L - 2)
+      for (size_t i = 0; i < coarse.size(); ++i) {
+        float want[3];
+        output_color(*table_, triples[i], ctx.color_weights, ctx.color_rule, want);
+        EXPECT_EQ((*got)[i], (std::array<float, 3>{want[0], want[1], want[2]})) << i;
+      }
+    EXPECT_EQ(cut(*coarse_first, 'z', 0, 0, 0, 16, 16), finest) << "a coarse request first changed finest voxels";
+  }
+  auto s = make(table_, "identity", p);
+  for (const int bad : {-2, L}) {
+    SynthesisOptions o;
+    o.level = bad;
+    auto r = s->synthesize(TargetSet::box({0, 0, 0}, 2, 2, 2).value(), null_interrupter(), nullptr, o);
+    ASSERT_FALSE(r.is_ok());
+    EXPECT_EQ(r.status().field(), "level");
+  }
 }
 
 TEST_F(SynthesizerTest, TinyCacheBudgetEvictsBricksAndKeepsResults) {

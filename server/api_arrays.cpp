@@ -1,0 +1,136 @@
+// Handlers of the chunked-array views (chunked_arrays.h): decode the path, ask the volume
+// service, encode. Every answer carries CORS headers (browser viewers read them cross-origin);
+// chunks carry a strong ETag from (volume spec, format, dataset, chunk) and are immutable.
+#include <charconv>
+
+#include "api.h"
+#include "chunked_arrays.h"
+#include "core/image_io.h"
+#include "query_params.h"
+#include "synthesis/target.h"
+
+namespace solidtex::server {
+namespace {
+
+using nlohmann::json;
+
+void add_cors(HttpResponse& r) {
+  r.headers.push_back({"Access-Control-Allow-Origin", "*"});
+  r.headers.push_back({"Access-Control-Expose-Headers", "ETag, Content-Length, X-Voxels-Synthesized"});
+}
+
+HttpResponse array_error(const Status& s) {
+  HttpResponse r = HttpResponse::error(s);
+  add_cors(r);
+  return r;
+}
+
+// A path segment that must be a non-negative index; anything else names no array element.
+Result<int64_t> index_segment(const HttpRequest& r, const std::string& name) {
+  const std::string& s = r.param(name);
+  int64_t v = -1;
+  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (ec != std::errc() || end != s.data() + s.size() || v < 0)
+    return Status(StatusCode::kNotFound, "'" + s + "' is not an index of the array", name);
+  return v;
+}
+
+}  // namespace
+
+Result<Api::ArrayView> Api::array_view(const HttpRequest& r) {
+  SOLIDTEX_RETURN_IF_ERROR(QueryParams::parse(r.query, {}).status());
+  SOLIDTEX_ASSIGN_OR_RETURN(const VolumeService::ArrayInfo info, volumes_.array_info(r.param("id")));
+  ArrayView view;
+  view.window.scales = info.levels;
+  view.window.extent = config_.array_extent;
+  view.tag = info.tag;
+  return view;
+}
+
+HttpResponse Api::array_metadata(const HttpRequest& r, const std::function<Result<json>(const ArrayView&)>& make) {
+  auto result = [&]() -> Result<HttpResponse> {
+    SOLIDTEX_ASSIGN_OR_RETURN(const ArrayView view, array_view(r));
+    SOLIDTEX_ASSIGN_OR_RETURN(const json j, make(view));
+    HttpResponse out = HttpResponse::json(200, j);
+    // The window follows --array-extent, so metadata may change across restarts: revalidate.
+    out.headers.push_back({"ETag", "\"" + view.tag + "-" + std::to_string(view.window.extent) + "-" + r.route + "\""});
+    out.headers.push_back({"Cache-Control", "public, max-age=60"});
+    add_cors(out);
+    return out;
+  }();
+  return result ? *result : array_error(result.status());
+}
+
+Result<int> Api::dataset_of(const HttpRequest& r, const ArrayView& view) {
+  SOLIDTEX_ASSIGN_OR_RETURN(const int64_t scale, index_segment(r, "scale"));
+  if (scale >= view.window.scales)
+    return Status(StatusCode::kNotFound,
+                  "no dataset " + std::to_string(scale) + " (0.." + std::to_string(view.window.scales - 1) + ")", "scale");
+  return int(scale);
+}
+
+HttpResponse Api::zarr_group(const HttpRequest& r) {
+  return array_metadata(r, [&](const ArrayView& v) -> Result<json> { return ome_zarr_group(v.window, r.param("id")); });
+}
+
+HttpResponse Api::zarr_array(const HttpRequest& r) {
+  return array_metadata(r, [&](const ArrayView& v) -> Result<json> {
+    SOLIDTEX_ASSIGN_OR_RETURN(const int scale, dataset_of(r, v));
+    return zarr3_array(v.window, scale);
+  });
+}
+
+HttpResponse Api::zarr2_group(const HttpRequest& r) {
+  return array_metadata(r, [](const ArrayView&) -> Result<json> { return server::zarr2_group(); });
+}
+
+HttpResponse Api::zarr2_attributes(const HttpRequest& r) {
+  return array_metadata(r, [&](const ArrayView& v) -> Result<json> { return ome_zarr04_attributes(v.window, r.param("id")); });
+}
+
+HttpResponse Api::zarr2_array(const HttpRequest& r) {
+  return array_metadata(r, [&](const ArrayView& v) -> Result<json> {
+    SOLIDTEX_ASSIGN_OR_RETURN(const int scale, dataset_of(r, v));
+    return server::zarr2_array(v.window, scale);
+  });
+}
+
+HttpResponse Api::zarr_chunk(const HttpRequest& r) { return array_chunk(r, "zarr3"); }
+
+HttpResponse Api::zarr2_chunk(const HttpRequest& r) { return array_chunk(r, "zarr2"); }
+
+HttpResponse Api::array_chunk(const HttpRequest& r, const std::string& format) {
+  auto result = [&]() -> Result<HttpResponse> {
+    SOLIDTEX_ASSIGN_OR_RETURN(const ArrayView view, array_view(r));
+    SOLIDTEX_ASSIGN_OR_RETURN(const int scale, dataset_of(r, view));
+    SOLIDTEX_ASSIGN_OR_RETURN(const int64_t c, index_segment(r, "c"));
+    if (c != 0) return Status(StatusCode::kNotFound, "the channel axis has one chunk (index 0)", "c");
+    std::array<int64_t, 3> czyx{};
+    const char* names[3] = {"cz", "cy", "cx"};
+    for (int a = 0; a < 3; ++a) {
+      SOLIDTEX_ASSIGN_OR_RETURN(czyx[size_t(a)], index_segment(r, names[a]));
+    }
+    SOLIDTEX_ASSIGN_OR_RETURN(const ChunkBox box, chunk_box(view.window, scale, czyx));
+    SOLIDTEX_ASSIGN_OR_RETURN(TargetSet target, TargetSet::box(box.min, box.size, box.size, box.size));
+    const int level = view.window.scales - 1 - scale;
+    auto qr = query_volume(r, "chunk", target, std::nullopt, level);
+    if (!qr) return qr.status();
+    ImageF img(box.size, box.size * box.size, 3);
+    for (size_t i = 0; i < qr->rgb.size(); ++i)
+      for (size_t k = 0; k < 3; ++k) img.pixels[i * 3 + k] = qr->rgb[i][k];
+    SOLIDTEX_ASSIGN_OR_RETURN(std::string body, zstd_compress(chunk_bytes(to_srgb8(img), box.size)));
+    HttpResponse out;
+    out.content_type = "application/octet-stream";
+    out.body = std::move(body);
+    out.headers.push_back({"ETag", "\"" + view.tag + "-" + format + "-" + std::to_string(scale) + "-" +
+                                       std::to_string(czyx[0]) + "." + std::to_string(czyx[1]) + "." +
+                                       std::to_string(czyx[2]) + "\""});
+    out.headers.push_back({"Cache-Control", "public, max-age=31536000, immutable"});
+    out.headers.push_back({"X-Voxels-Synthesized", std::to_string(qr->voxels_synthesized)});
+    add_cors(out);
+    return out;
+  }();
+  return result ? *result : array_error(result.status());
+}
+
+}  // namespace solidtex::server

@@ -1,0 +1,130 @@
+"""Volumes as chunked arrays (issue #14): OME-Zarr 0.5 (Zarr v3) under /zarr and Zarr v2 /
+OME-Zarr 0.4 under /zarr2, opened by URL with zarr-python 3 over fsspec's HTTP store, and
+compared bit for bit with the region endpoint; the HTTP behaviour chunked-array clients rely
+on (never 404 for "not computed yet", 404 only outside the array, strong ETags stable across
+restarts, immutable caching, CORS)."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import requests
+
+from support import ANALYSIS, upload_ready
+
+zarr = pytest.importorskip("zarr", reason="zarr-python 3 is not installed (tests/python/requirements.txt)")
+
+EXTENT = 128  # --array-extent: dataset 0 is 128^3 finest voxels, four chunks a side
+
+
+@pytest.fixture(scope="module")
+def volume(tmp_path_factory, binary, exemplars):
+    from support import ServerFactory
+    factory = ServerFactory(tmp_path_factory.mktemp("arrays"))
+    srv = factory.start("--array-extent", EXTENT)
+    ex = upload_ready(srv.client, exemplars["spots"])
+    vol = srv.client.create_volume(exemplar=ex["id"], seed=3)
+    yield srv, vol["id"], factory
+    factory.close()
+
+
+def region_czyx(srv, vid, lo, hi):
+    """The region endpoint's sRGB voxels of the box [lo, hi) (z, y, x order) as (c, z, y, x)."""
+    (z0, y0, x0), (z1, y1, x1) = lo, hi
+    box = srv.client.region(vid, (x0, y0, z0), (x1 - x0, y1 - y0, z1 - z0), fmt="uint8")
+    return np.moveaxis(box, -1, 0)
+
+
+def test_zarr3_group_reads_the_region_endpoints_voxels(volume):
+    srv, vid, _ = volume
+    group = zarr.open_group(f"{srv.url}/v1/volumes/{vid}/zarr", mode="r", zarr_format=3)
+    ome = group.attrs["ome"]
+    assert ome["version"] == "0.5"
+    (ms,) = ome["multiscales"]
+    assert [a["name"] for a in ms["axes"]] == ["c", "z", "y", "x"]
+    assert [d["path"] for d in ms["datasets"]] == ["0", "1", "2"]  # the suite's 3 synthesis levels
+    assert ms["datasets"][1]["coordinateTransformations"][0]["scale"] == [1.0, 2.0, 2.0, 2.0]
+    finest = group["0"]
+    assert finest.shape == (3, EXTENT, EXTENT, EXTENT)
+    assert finest.chunks == (3, 32, 32, 32)
+    assert finest.dtype == np.uint8
+    assert list(finest.metadata.dimension_names) == ["c", "z", "y", "x"]
+    # one chunk, aligned, then a box across eight chunks
+    aligned = finest[:, 32:64, 0:32, 64:96]
+    assert np.array_equal(aligned, region_czyx(srv, vid, (32, 0, 64), (64, 32, 96)))
+    unaligned = finest[:, 20:45, 30:37, 50:90]
+    assert np.array_equal(unaligned, region_czyx(srv, vid, (20, 30, 50), (45, 37, 90)))
+    assert unaligned.std() > 5, "a flat box says nothing"
+    # a coarser dataset: synthesis level 1 of 0..2, half the side, a different image
+    coarse = group["1"]
+    assert coarse.shape == (3, EXTENT // 2, EXTENT // 2, EXTENT // 2)
+    c = coarse[:, 0:16, 0:16, 0:16]
+    assert c.std() > 5
+    assert np.array_equal(c, coarse[:, 0:16, 0:16, 0:16])
+
+
+def test_zarr2_mirror_reads_the_same_voxels(volume):
+    srv, vid, _ = volume
+    group = zarr.open_group(f"{srv.url}/v1/volumes/{vid}/zarr2", mode="r", zarr_format=2)
+    (ms,) = group.attrs["multiscales"]
+    assert ms["version"] == "0.4"
+    finest = group["0"]
+    assert finest.shape == (3, EXTENT, EXTENT, EXTENT)
+    assert np.array_equal(finest[:, 5:40, 60:64, 0:33], region_czyx(srv, vid, (5, 60, 0), (40, 64, 33)))
+    v3 = zarr.open_group(f"{srv.url}/v1/volumes/{vid}/zarr", mode="r", zarr_format=3)
+    assert np.array_equal(group["2"][:], v3["2"][:])
+
+
+def test_chunks_are_immutable_cors_and_404_only_outside_the_array(volume, binary):
+    srv, vid, factory = volume
+    base = f"{srv.url}/v1/volumes/{vid}"
+    first = requests.get(f"{base}/zarr/0/c/0/3/2/1", timeout=120)  # never computed before: 200, not 404
+    assert first.status_code == 200, first.text
+    assert first.headers["Cache-Control"] == "public, max-age=31536000, immutable"
+    assert first.headers["Access-Control-Allow-Origin"] == "*"
+    assert "ETag" in first.headers["Access-Control-Expose-Headers"]
+    etag = first.headers["ETag"]
+    assert etag.startswith('"') and etag.endswith('"')
+    again = requests.get(f"{base}/zarr/0/c/0/3/2/1", timeout=120)
+    assert again.content == first.content and again.headers["ETag"] == etag
+    assert again.headers["X-Voxels-Synthesized"] == "0"
+    other = requests.get(f"{base}/zarr/0/c/0/3/2/0", timeout=120)
+    assert other.headers["ETag"] != etag
+    v2 = requests.get(f"{base}/zarr2/0/0/3/2/1", timeout=120)
+    assert v2.status_code == 200 and v2.headers["ETag"] != etag
+    for outside in ("zarr/0/c/0/4/0/0", "zarr/0/c/0/0/0/-1", "zarr/0/c/1/0/0/0", "zarr/3/c/0/0/0/0",
+                    "zarr/0/c/0/0/0/x", "zarr/9/zarr.json", "zarr2/0/0/0/0/4", "zarr2/3/.zarray"):
+        r = requests.get(f"{base}/{outside}", timeout=60)
+        assert r.status_code == 404, (outside, r.status_code, r.text)
+        assert r.headers.get("Access-Control-Allow-Origin") == "*", outside
+    assert requests.get(f"{srv.url}/v1/volumes/vol_missing/zarr/zarr.json", timeout=60).status_code == 404
+    assert requests.get(f"{base}/zarr/zarr.json", params={"x": 1}, timeout=60).status_code == 400
+    # the same chunk, the same bytes and ETag after a restart
+    data_dir = srv.data_dir
+    assert srv.stop(grace=10) == 0
+    restarted = factory.start("--array-extent", EXTENT, data_dir=data_dir)
+    r = requests.get(f"{restarted.url}/v1/volumes/{vid}/zarr/0/c/0/3/2/1", timeout=120)
+    assert r.status_code == 200 and r.content == first.content and r.headers["ETag"] == etag
+
+
+@pytest.mark.parametrize("extent", ["33", "16", "0", str((1 << 20) + 32), "x"])
+def test_array_extent_outside_its_range_stops_the_server_naming_the_flag(binary, extent, tmp_path):
+    import subprocess
+    proc = subprocess.run([str(binary), "serve", "--port", "1", "--data", str(tmp_path / "d"), "--array-extent", extent],
+                          capture_output=True, text=True, timeout=30)
+    assert proc.returncode == 2, proc
+    assert "--array-extent" in proc.stderr, proc.stderr
+
+
+def test_array_extent_at_its_ends_shapes_the_arrays(server, exemplars):
+    # the documented ends of --array-extent: one chunk a side, and 2^20 voxels (32768 chunks)
+    for extent in (32, 1 << 20):
+        srv = server("--array-extent", extent)
+        ex = upload_ready(srv.client, exemplars["spots"])
+        vid = srv.client.create_volume(exemplar=ex["id"], seed=1)["id"]
+        meta = requests.get(f"{srv.url}/v1/volumes/{vid}/zarr/0/zarr.json", timeout=60).json()
+        assert meta["shape"] == [3, extent, extent, extent]
+        last = extent // 32 - 1
+        r = requests.get(f"{srv.url}/v1/volumes/{vid}/zarr/0/c/0/{last}/{last}/{last}", timeout=120)
+        assert r.status_code == 200, r.text
+        assert requests.get(f"{srv.url}/v1/volumes/{vid}/zarr/0/c/0/{last + 1}/0/0", timeout=60).status_code == 404
+        srv.stop(grace=10)
