@@ -167,7 +167,7 @@ Status check_plane_weights(const std::vector<double>& w, const std::string& fiel
 Api::Api(const ServerConfig& config, ExemplarService& exemplars, FieldService& fields, VolumeService& volumes,
          MeshService& meshes, Metrics& metrics, const WorkerPool& pool, const std::atomic<bool>& shutting_down)
     : config_(config), exemplars_(exemplars), fields_(fields), volumes_(volumes), meshes_(meshes), metrics_(metrics), pool_(pool),
-      shutting_down_(shutting_down) {}
+      chunks_(config.chunk_cache_bytes), shutting_down_(shutting_down) {}
 
 Result<std::unique_ptr<RequestInterrupter>> Api::interrupter_for(const HttpRequest& r, const std::optional<std::string>& timeout) const {
   double seconds = config_.deadline_s;

@@ -11,6 +11,7 @@
 #include <optional>
 #include <string>
 
+#include "chunk_cache.h"
 #include "chunked_arrays.h"
 #include "exemplar_service.h"
 #include "field_service.h"
@@ -98,6 +99,7 @@ class Api {
   MeshService& meshes_;
   Metrics& metrics_;
   const WorkerPool& pool_;
+  ChunkCache chunks_;  // encoded array chunks by ETag (--chunk-cache-mb)
   const std::atomic<bool>& shutting_down_;
 };
 

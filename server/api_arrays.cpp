@@ -111,22 +111,28 @@ HttpResponse Api::array_chunk(const HttpRequest& r, const std::string& format) {
       SOLIDTEX_ASSIGN_OR_RETURN(czyx[size_t(a)], index_segment(r, names[a]));
     }
     SOLIDTEX_ASSIGN_OR_RETURN(const ChunkBox box, chunk_box(view.window, scale, czyx));
-    SOLIDTEX_ASSIGN_OR_RETURN(TargetSet target, TargetSet::box(box.min, box.size, box.size, box.size));
-    const int level = view.window.scales - 1 - scale;
-    auto qr = query_volume(r, "chunk", target, std::nullopt, level);
-    if (!qr) return qr.status();
-    ImageF img(box.size, box.size * box.size, 3);
-    for (size_t i = 0; i < qr->rgb.size(); ++i)
-      for (size_t k = 0; k < 3; ++k) img.pixels[i * 3 + k] = qr->rgb[i][k];
-    SOLIDTEX_ASSIGN_OR_RETURN(std::string body, zstd_compress(chunk_bytes(to_srgb8(img), box.size)));
+    const std::string etag = "\"" + view.tag + "-" + format + "-" + std::to_string(scale) + "-" + std::to_string(czyx[0]) +
+                             "." + std::to_string(czyx[1]) + "." + std::to_string(czyx[2]) + "\"";
+    int64_t synthesized = 0;
+    std::shared_ptr<const std::string> body = chunks_.find(etag);
+    if (!body) {
+      SOLIDTEX_ASSIGN_OR_RETURN(TargetSet target, TargetSet::box(box.min, box.size, box.size, box.size));
+      auto qr = query_volume(r, "chunk", target, std::nullopt, view.window.scales - 1 - scale);
+      if (!qr) return qr.status();
+      synthesized = qr->voxels_synthesized;
+      ImageF img(box.size, box.size * box.size, 3);
+      for (size_t i = 0; i < qr->rgb.size(); ++i)
+        for (size_t k = 0; k < 3; ++k) img.pixels[i * 3 + k] = qr->rgb[i][k];
+      SOLIDTEX_ASSIGN_OR_RETURN(std::string bytes, zstd_compress(chunk_bytes(to_srgb8(img), box.size)));
+      body = std::make_shared<const std::string>(std::move(bytes));
+      chunks_.insert(etag, body);
+    }
     HttpResponse out;
     out.content_type = "application/octet-stream";
-    out.body = std::move(body);
-    out.headers.push_back({"ETag", "\"" + view.tag + "-" + format + "-" + std::to_string(scale) + "-" +
-                                       std::to_string(czyx[0]) + "." + std::to_string(czyx[1]) + "." +
-                                       std::to_string(czyx[2]) + "\""});
+    out.body = *body;
+    out.headers.push_back({"ETag", etag});
     out.headers.push_back({"Cache-Control", "public, max-age=31536000, immutable"});
-    out.headers.push_back({"X-Voxels-Synthesized", std::to_string(qr->voxels_synthesized)});
+    out.headers.push_back({"X-Voxels-Synthesized", std::to_string(synthesized)});
     add_cors(out);
     return out;
   }();

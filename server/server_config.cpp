@@ -26,6 +26,7 @@ Status ServerConfig::validate() const {
   if (max_voxels < 1 || max_voxels > kMaxTargetSamples) return out_of_range("--max-voxels", "[1, 2^24]");
   if (array_extent < 32 || array_extent > (int64_t(1) << 20) || array_extent % 32)
     return out_of_range("--array-extent", "[32, 1048576], a multiple of 32");
+  if (chunk_cache_bytes < 0 || chunk_cache_bytes > (int64_t(64) << 30)) return out_of_range("--chunk-cache-mb", "[0, 65536]");
   if (max_request_bytes < (int64_t(16) << 20) || max_request_bytes > (int64_t(1) << 40))
     return out_of_range("--max-request-mb", "[16, 1048576]");
   if (volume_state_bytes < 0 || volume_state_bytes > (int64_t(1) << 40)) return out_of_range("--volume-state-mb", "[0, 1048576]");

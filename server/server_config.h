@@ -40,6 +40,8 @@ struct ServerConfig {
   // Side of the chunked-array views (/zarr, /zarr2) in finest voxels from the origin, a
   // multiple of 32 in [32, 2^20]: the window on the unbounded volume those clients see.
   int64_t array_extent = 1024;
+  // Encoded array chunks kept for repeated reads (chunk_cache.h), bytes, [0, 64 GiB]; 0: none.
+  int64_t chunk_cache_bytes = int64_t(64) << 20;
 
   Status validate() const;
 };

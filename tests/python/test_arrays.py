@@ -106,13 +106,31 @@ def test_chunks_are_immutable_cors_and_404_only_outside_the_array(volume, binary
     assert r.status_code == 200 and r.content == first.content and r.headers["ETag"] == etag
 
 
-@pytest.mark.parametrize("extent", ["33", "16", "0", str((1 << 20) + 32), "x"])
-def test_array_extent_outside_its_range_stops_the_server_naming_the_flag(binary, extent, tmp_path):
+@pytest.mark.parametrize("flag,value", [("--array-extent", v) for v in ("33", "16", "0", str((1 << 20) + 32), "x")]
+                         + [("--chunk-cache-mb", v) for v in ("-1", "65537", "1.5")])
+def test_array_flags_outside_their_range_stop_the_server_naming_the_flag(binary, flag, value, tmp_path):
     import subprocess
-    proc = subprocess.run([str(binary), "serve", "--port", "1", "--data", str(tmp_path / "d"), "--array-extent", extent],
+    proc = subprocess.run([str(binary), "serve", "--port", "1", "--data", str(tmp_path / "d"), flag, value],
                           capture_output=True, text=True, timeout=30)
     assert proc.returncode == 2, proc
-    assert "--array-extent" in proc.stderr, proc.stderr
+    assert flag in proc.stderr, proc.stderr
+
+
+def test_chunk_cache_at_its_ends_serves_the_same_bytes(server, exemplars):
+    # 0 keeps no encoded chunk (every read goes through the voxel cache), 65536 MiB keeps them all
+    got = {}
+    for mb in (0, 65536):
+        srv = server("--chunk-cache-mb", mb, "--array-extent", 64)
+        ex = upload_ready(srv.client, exemplars["spots"])
+        vid = srv.client.create_volume(exemplar=ex["id"], seed=2)["id"]
+        url = f"{srv.url}/v1/volumes/{vid}/zarr/0/c/0/1/0/1"
+        first, again = requests.get(url, timeout=120), requests.get(url, timeout=120)
+        assert first.status_code == again.status_code == 200
+        assert first.content == again.content and first.headers["ETag"] == again.headers["ETag"]
+        assert again.headers["X-Voxels-Synthesized"] == "0"  # from the voxel cache or the chunk cache
+        got[mb] = first.content
+        srv.stop(grace=10)
+    assert got[0] == got[65536]
 
 
 def test_array_extent_at_its_ends_shapes_the_arrays(server, exemplars):
