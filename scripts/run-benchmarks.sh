@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Runs every benchmark in bench/ and prints one JSON document:
 #   {"analysis": [...], "slice": {...}, "field": {...}, "surface": {...}, "service": {...},
-#    "quality": {...}, "rss": {...}}. Takes about two hours on 2 cores (QUALITY_SIZE=128 for a quicker
+#    "arrays": {...}, "quality": {...}, "rss": {...}}. Takes about two hours on 2 cores (QUALITY_SIZE=128 for a quicker
 #    quality run; RSS_QUICK=1 for smaller memory probes).
 # Uses ../shared/data/exemplars/wood_grain.png when present, else a procedural wood exemplar.
 set -euo pipefail
@@ -37,6 +37,8 @@ fi
 echo ', "service":'
 "$(cd "$(dirname "$0")/.." && pwd)/scripts/setup-python.sh" "$(cd "$build" && pwd)"
 "$build/venv/bin/python" "$(dirname "$0")/../bench/bench_service.py" "$build"
+echo ', "arrays":'
+"$build/venv/bin/python" "$(dirname "$0")/../bench/bench_arrays.py" "$build"
 echo ', "quality":'
 "$build/venv/bin/python" "$(dirname "$0")/../bench/bench_quality.py" "$build" --size "${QUALITY_SIZE:-256}"
 echo ', "rss":'

@@ -62,6 +62,19 @@ def test_zarr3_group_reads_the_region_endpoints_voxels(volume):
     assert np.array_equal(c, coarse[:, 0:16, 0:16, 0:16])
 
 
+def test_tensorstore_reads_the_same_voxels_in_both_formats(volume):
+    ts = pytest.importorskip("tensorstore", reason="tensorstore is not installed (tests/python/requirements.txt)")
+    srv, vid, _ = volume
+    # bounded retries: a 503 (overload) is retried a few times, then reported
+    ctx = ts.Context({"http_request_retries": {"max_retries": 4, "initial_delay": "100ms", "max_delay": "2s"}})
+    want = region_czyx(srv, vid, (40, 3, 70), (72, 19, 101))
+    for driver, path in (("zarr3", "zarr/0/"), ("zarr", "zarr2/0/")):
+        t = ts.open({"driver": driver, "kvstore": f"{srv.url}/v1/volumes/{vid}/{path}"}, context=ctx, read=True).result()
+        assert t.shape == (3, EXTENT, EXTENT, EXTENT)
+        got = t[:, 40:72, 3:19, 70:101].read().result()
+        assert np.array_equal(got, want), driver
+
+
 def test_zarr2_mirror_reads_the_same_voxels(volume):
     srv, vid, _ = volume
     group = zarr.open_group(f"{srv.url}/v1/volumes/{vid}/zarr2", mode="r", zarr_format=2)
