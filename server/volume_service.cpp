@@ -9,6 +9,7 @@
 #include <mutex>
 #include <string_view>
 #include <thread>
+#include <utility>
 
 #include "api_json.h"
 #include "field/field_file.h"
@@ -392,6 +393,30 @@ struct VolumeService::Impl {
     rebalance_cache();
   }
 
+  // The volume's state held for one call: not evictable until the Hold is destroyed.
+  class Hold {
+   public:
+    Hold(Impl& impl, std::shared_ptr<Volume> v, std::shared_ptr<VolumeState> state)
+        : impl_(&impl), volume(std::move(v)), state(std::move(state)) {}
+    Hold(Hold&& o) noexcept : impl_(std::exchange(o.impl_, nullptr)), volume(std::move(o.volume)), state(std::move(o.state)) {}
+    Hold& operator=(Hold&&) = delete;
+    ~Hold() {
+      if (impl_) impl_->release(*volume);
+    }
+
+   private:
+    Impl* impl_;
+
+   public:
+    std::shared_ptr<Volume> volume;
+    std::shared_ptr<VolumeState> state;
+  };
+  Result<Hold> hold(const std::string& id) {
+    SOLIDTEX_ASSIGN_OR_RETURN(auto v, find(id));
+    SOLIDTEX_ASSIGN_OR_RETURN(std::shared_ptr<VolumeState> state, acquire(v));
+    return Hold(*this, std::move(v), std::move(state));
+  }
+
   // The volume's state for one request, built when not loaded; release() must follow.
   Result<std::shared_ptr<VolumeState>> acquire(const std::shared_ptr<Volume>& v) {
     auto loaded = [&]() -> std::shared_ptr<VolumeState> {
@@ -636,13 +661,9 @@ Status VolumeService::check_target_size(int64_t samples, const std::string& fiel
 }
 
 Result<VolumeService::ArrayInfo> VolumeService::array_info(const std::string& id) {
-  SOLIDTEX_ASSIGN_OR_RETURN(auto v, impl_->find(id));
-  SOLIDTEX_ASSIGN_OR_RETURN(std::shared_ptr<VolumeState> state, impl_->acquire(v));
-  struct Release {
-    Impl& impl;
-    Volume& v;
-    ~Release() { impl.release(v); }
-  } release{*impl_, *v};
+  SOLIDTEX_ASSIGN_OR_RETURN(const Impl::Hold held, impl_->hold(id));
+  const auto& v = held.volume;
+  const auto& state = held.state;
   ArrayInfo out;
   out.levels = state->regions ? 1 : state->synths[0]->table().levels();
   uint64_t h = 0xcbf29ce484222325ull;  // FNV-1a of the spec's canonical dump (sorted keys)
@@ -658,13 +679,9 @@ Result<QueryResult> VolumeService::query(const std::string& id, const std::strin
   // --max-voxels bounds the sizes clients choose; a chunk of the array views is their fixed
   // 32^3 unit (still bounded by --max-request-mb), which every array client must be able to read.
   if (kind != "chunk") SOLIDTEX_RETURN_IF_ERROR(check_target_size(int64_t(target.sample.size()), "size"));
-  SOLIDTEX_ASSIGN_OR_RETURN(auto v, impl_->find(id));
-  SOLIDTEX_ASSIGN_OR_RETURN(std::shared_ptr<VolumeState> state, impl_->acquire(v));
-  struct Release {
-    Impl& impl;
-    Volume& v;
-    ~Release() { impl.release(v); }
-  } release{*impl_, *v};
+  SOLIDTEX_ASSIGN_OR_RETURN(const Impl::Hold held, impl_->hold(id));
+  const auto& v = held.volume;
+  const auto& state = held.state;
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<SynthesisStats> per_region;
   QueryResult out;
