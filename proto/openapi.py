@@ -325,6 +325,13 @@ paths = {
  "/v1/volumes/{id}/zarr2/{scale}/{c}/{cz}/{cy}/{cx}": {"parameters": [pid(), ZARR_SCALE, *ZARR_CHUNK],
    "get": {"operationId": "zarr2_chunk", "summary": "One Zarr v2 chunk: the same bytes as the Zarr v3 chunk at the same indices.",
      "responses": {"200": ZARR_CHUNK_OUT, **errs("400", "404", "422", "503", "504")}}},
+ "/v1/volumes/{id}/precomputed/info": {"parameters": [pid()],
+   "get": {"operationId": "precomputed_info", "summary": "Neuroglancer precomputed `info` of the volume: one scale per synthesis level (key s = dataset s of /zarr, resolution 2^s), num_channels 3, uint8, raw encoding; chunk sizes 32^3 and the flat 64x64x8, 64x8x64, 8x64x64 for 2-D views. Open in Neuroglancer as `precomputed://URL` (without /info).",
+     "responses": {"200": ZARR_META, **errs("400", "404", "503")}}},
+ "/v1/volumes/{id}/precomputed/{scale}/{chunk}": {"parameters": [pid(), zarr_index("scale", "Scale key (dataset)."),
+     {"name": "chunk", "in": "path", "required": True, "description": "x0-x1_y0-y1_z0-z1 voxel bounds of the scale: inside it, at most 64 a side and 32768 voxels (else 404).", "schema": {"type": "string", "pattern": "^[0-9]+-[0-9]+_[0-9]+-[0-9]+_[0-9]+-[0-9]+$"}}],
+   "get": {"operationId": "precomputed_chunk", "summary": "One raw chunk: uint8 sRGB, x fastest, channel slowest (the bytes of a C-order (c, z, y, x) Zarr chunk of the same box, uncompressed).",
+     "responses": {"200": ZARR_CHUNK_OUT, **errs("400", "404", "422", "503", "504")}}},
  "/v1/volumes/{id}/stats": {"parameters": [pid()],
    "get": {"operationId": "volume_stats", "summary": "Voxels per level, cache bytes and hits, the loaded state's resident bytes and evictions, the last requests' dependent-set sizes.", "responses": {"200": js(ref("Stats")), **errs("404")}}},
 }

@@ -69,6 +69,8 @@ class Api {
   HttpResponse zarr2_attributes(const HttpRequest& r);
   HttpResponse zarr2_array(const HttpRequest& r);
   HttpResponse zarr2_chunk(const HttpRequest& r);
+  HttpResponse precomputed_info(const HttpRequest& r);
+  HttpResponse precomputed_chunk(const HttpRequest& r);
 
  private:
   Result<std::unique_ptr<RequestInterrupter>> interrupter_for(const HttpRequest& r, const std::optional<std::string>& timeout) const;
@@ -88,6 +90,8 @@ class Api {
   Result<ArrayView> array_view(const HttpRequest& r);
   Result<int> dataset_of(const HttpRequest& r, const ArrayView& view);
   HttpResponse array_chunk(const HttpRequest& r, const std::string& format);  // the same bytes in every format
+  Result<HttpResponse> serve_box(const HttpRequest& r, const ArrayView& view, int scale, const ChunkBox& box,
+                                 const std::string& format, const std::string& key, bool zstd);
   HttpResponse array_metadata(const HttpRequest& r, const std::function<Result<nlohmann::json>(const ArrayView&)>& make);
   Result<HttpResponse> synthesize_image(const HttpRequest& r, const std::string& kind, const TargetSet& target,
                                         const std::optional<std::string>& timeout);

@@ -111,32 +111,56 @@ HttpResponse Api::array_chunk(const HttpRequest& r, const std::string& format) {
       SOLIDTEX_ASSIGN_OR_RETURN(czyx[size_t(a)], index_segment(r, names[a]));
     }
     SOLIDTEX_ASSIGN_OR_RETURN(const ChunkBox box, chunk_box(view.window, scale, czyx));
-    const std::string etag = "\"" + view.tag + "-" + format + "-" + std::to_string(scale) + "-" + std::to_string(czyx[0]) +
-                             "." + std::to_string(czyx[1]) + "." + std::to_string(czyx[2]) + "\"";
-    int64_t synthesized = 0;
-    std::shared_ptr<const std::string> body = chunks_.find(etag);
-    if (!body) {
-      SOLIDTEX_ASSIGN_OR_RETURN(TargetSet target, TargetSet::box(box.min, box.size, box.size, box.size));
-      auto qr = query_volume(r, "chunk", target, std::nullopt, view.window.scales - 1 - scale);
-      if (!qr) return qr.status();
-      synthesized = qr->voxels_synthesized;
-      ImageF img(box.size, box.size * box.size, 3);
-      for (size_t i = 0; i < qr->rgb.size(); ++i)
-        for (size_t k = 0; k < 3; ++k) img.pixels[i * 3 + k] = qr->rgb[i][k];
-      SOLIDTEX_ASSIGN_OR_RETURN(std::string bytes, zstd_compress(chunk_bytes(to_srgb8(img), box.size)));
-      body = std::make_shared<const std::string>(std::move(bytes));
-      chunks_.insert(etag, body);
-    }
-    HttpResponse out;
-    out.content_type = "application/octet-stream";
-    out.body = *body;
-    out.headers.push_back({"ETag", etag});
-    out.headers.push_back({"Cache-Control", "public, max-age=31536000, immutable"});
-    out.headers.push_back({"X-Voxels-Synthesized", std::to_string(synthesized)});
-    add_cors(out);
-    return out;
+    const std::string key = std::to_string(czyx[0]) + "." + std::to_string(czyx[1]) + "." + std::to_string(czyx[2]);
+    return serve_box(r, view, scale, box, format, key, /*zstd=*/true);
   }();
   return result ? *result : array_error(result.status());
+}
+
+HttpResponse Api::precomputed_info(const HttpRequest& r) {
+  return array_metadata(r, [](const ArrayView& v) -> Result<json> { return server::precomputed_info(v.window); });
+}
+
+HttpResponse Api::precomputed_chunk(const HttpRequest& r) {
+  auto result = [&]() -> Result<HttpResponse> {
+    SOLIDTEX_ASSIGN_OR_RETURN(const ArrayView view, array_view(r));
+    SOLIDTEX_ASSIGN_OR_RETURN(const int scale, dataset_of(r, view));
+    SOLIDTEX_ASSIGN_OR_RETURN(const ChunkBox box, precomputed_box(view.window, scale, r.param("chunk")));
+    return serve_box(r, view, scale, box, "precomputed", r.param("chunk"), /*zstd=*/false);
+  }();
+  return result ? *result : array_error(result.status());
+}
+
+// The voxels of `box` at dataset `scale` as C-order (c, z, y, x) sRGB8, zstd-compressed or raw,
+// from the chunk cache when an earlier request encoded them.
+Result<HttpResponse> Api::serve_box(const HttpRequest& r, const ArrayView& view, int scale, const ChunkBox& box,
+                                    const std::string& format, const std::string& key, bool zstd) {
+  const std::string etag = "\"" + view.tag + "-" + format + "-" + std::to_string(scale) + "-" + key + "\"";
+  int64_t synthesized = 0;
+  std::shared_ptr<const std::string> body = chunks_.find(etag);
+  if (!body) {
+    SOLIDTEX_ASSIGN_OR_RETURN(TargetSet target, TargetSet::box(box.min, box.size[0], box.size[1], box.size[2]));
+    auto qr = query_volume(r, "chunk", target, std::nullopt, view.window.scales - 1 - scale);
+    if (!qr) return qr.status();
+    synthesized = qr->voxels_synthesized;
+    ImageF img(box.size[0], box.size[1] * box.size[2], 3);
+    for (size_t i = 0; i < qr->rgb.size(); ++i)
+      for (size_t k = 0; k < 3; ++k) img.pixels[i * 3 + k] = qr->rgb[i][k];
+    std::string bytes = chunk_bytes(to_srgb8(img), int64_t(qr->rgb.size()));
+    if (zstd) {
+      SOLIDTEX_ASSIGN_OR_RETURN(bytes, zstd_compress(bytes));
+    }
+    body = std::make_shared<const std::string>(std::move(bytes));
+    chunks_.insert(etag, body);
+  }
+  HttpResponse out;
+  out.content_type = "application/octet-stream";
+  out.body = *body;
+  out.headers.push_back({"ETag", etag});
+  out.headers.push_back({"Cache-Control", "public, max-age=31536000, immutable"});
+  out.headers.push_back({"X-Voxels-Synthesized", std::to_string(synthesized)});
+  add_cors(out);
+  return out;
 }
 
 }  // namespace solidtex::server

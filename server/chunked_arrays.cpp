@@ -2,6 +2,8 @@
 
 #include <zstd.h>
 
+#include <cstdio>
+
 namespace solidtex::server {
 namespace {
 
@@ -94,14 +96,55 @@ Result<ChunkBox> chunk_box(const ArrayWindow& w, int scale, const std::array<int
     if (c < 0 || c >= n)
       return Status(StatusCode::kNotFound,
                     "chunk index " + std::to_string(c) + " is outside the array (0.." + std::to_string(n - 1) + ")", "chunk");
-  return ChunkBox{{int(czyx[2] * kArrayChunk), int(czyx[1] * kArrayChunk), int(czyx[0] * kArrayChunk)}, kArrayChunk};
+  return ChunkBox{{int(czyx[2] * kArrayChunk), int(czyx[1] * kArrayChunk), int(czyx[0] * kArrayChunk)}};
 }
 
-std::string chunk_bytes(const std::vector<uint8_t>& srgb_zyxc, int size) {
-  const size_t voxels = size_t(size) * size_t(size) * size_t(size);
-  std::string out(3 * voxels, '\0');
-  for (size_t i = 0; i < voxels; ++i)
-    for (size_t c = 0; c < 3; ++c) out[c * voxels + i] = char(srgb_zyxc[i * 3 + c]);
+json precomputed_info(const ArrayWindow& w) {
+  json scales = json::array();
+  for (int s = 0; s < w.scales; ++s) {
+    const int64_t side = w.side(s), f = int64_t(1) << s;
+    scales.push_back({{"key", std::to_string(s)},
+                      {"size", {side, side, side}},
+                      {"resolution", {f, f, f}},
+                      {"voxel_offset", {0, 0, 0}},
+                      {"chunk_sizes", {{32, 32, 32}, {64, 64, 8}, {64, 8, 64}, {8, 64, 64}}},
+                      {"encoding", "raw"}});
+  }
+  return {{"@type", "neuroglancer_multiscale_volume"}, {"type", "image"}, {"data_type", "uint8"}, {"num_channels", 3},
+          {"scales", scales}};
+}
+
+Result<ChunkBox> precomputed_box(const ArrayWindow& w, int scale, const std::string& name) {
+  if (scale < 0 || scale >= w.scales)
+    return Status(StatusCode::kNotFound, "no scale " + std::to_string(scale) + " (0.." + std::to_string(w.scales - 1) + ")",
+                  "scale");
+  int64_t v[6];
+  char a[6];
+  int used = 0;
+  const bool parsed = std::sscanf(name.c_str(), "%ld%c%ld%c%ld%c%ld%c%ld%c%ld%n", &v[0], &a[0], &v[1], &a[1], &v[2], &a[2],
+                                  &v[3], &a[3], &v[4], &a[4], &v[5], &used) == 11 &&
+                      used == int(name.size()) && a[0] == '-' && a[1] == '_' && a[2] == '-' && a[3] == '_' && a[4] == '-';
+  if (!parsed) return Status(StatusCode::kNotFound, "'" + name + "' is not a chunk name x0-x1_y0-y1_z0-z1", "chunk");
+  ChunkBox box;
+  int64_t voxels = 1;
+  for (int k = 0; k < 3; ++k) {
+    const int64_t lo = v[2 * k], hi = v[2 * k + 1];
+    if (lo < 0 || hi <= lo || hi > w.side(scale) || hi - lo > 64)
+      return Status(StatusCode::kNotFound, "'" + name + "' is outside the array or wider than 64 voxels", "chunk");
+    box.size[size_t(k)] = int(hi - lo);
+    voxels *= hi - lo;
+  }
+  if (voxels > int64_t(kArrayChunk) * kArrayChunk * kArrayChunk)
+    return Status(StatusCode::kNotFound, "'" + name + "' has more than 32768 voxels", "chunk");
+  box.min = {int(v[0]), int(v[2]), int(v[4])};
+  return box;
+}
+
+std::string chunk_bytes(const std::vector<uint8_t>& srgb_zyxc, int64_t voxels) {
+  const size_t n = size_t(voxels);
+  std::string out(3 * n, '\0');
+  for (size_t i = 0; i < n; ++i)
+    for (size_t c = 0; c < 3; ++c) out[c * n + i] = char(srgb_zyxc[i * 3 + c]);
   return out;
 }
 

@@ -1,6 +1,7 @@
 // Volumes as chunked arrays (issue #14): the geometry, metadata and chunk bytes of the OME-Zarr
-// 0.5 (Zarr v3) and Zarr v2 / OME-Zarr 0.4 views of a volume, so that zarr-python, tensorstore
-// and OME-Zarr readers open a volume by URL and each chunk is synthesized when first asked for.
+// 0.5 (Zarr v3), Zarr v2 / OME-Zarr 0.4 and Neuroglancer precomputed views of a volume, so that
+// zarr-python, tensorstore, OME-Zarr readers and Neuroglancer open a volume by URL and each
+// chunk is synthesized when first asked for.
 //
 // Datasets: scale s (dataset path "s") is synthesis level levels - 1 - s, so "0" is the finest
 // and scale s has voxels 2^s finest voxels wide. Coarser datasets are the synthesis levels
@@ -46,13 +47,20 @@ nlohmann::json zarr2_array(const ArrayWindow& w, int scale);
 // outside the array (a scale or chunk index past the window), never for "not computed yet".
 struct ChunkBox {
   Voxel min;
-  int size = kArrayChunk;
+  std::array<int, 3> size{kArrayChunk, kArrayChunk, kArrayChunk};  // x, y, z
 };
 Result<ChunkBox> chunk_box(const ArrayWindow& w, int scale, const std::array<int64_t, 3>& czyx);
 
-// Chunk bytes in C order (c, z, y, x) from sRGB8 samples of the box in target order (x fastest,
-// then y, then z; three bytes per voxel).
-std::string chunk_bytes(const std::vector<uint8_t>& srgb_zyxc, int size);
+// Neuroglancer precomputed: the `info` (scale key s = dataset s, resolution 2^s, chunk sizes
+// 32^3 and the flat 64x64x8 with its rotations so 2-D views do not pay for depth, raw encoding),
+// and the box a chunk name "x0-x1_y0-y1_z0-z1" names: inside the dataset, at most 64 a side and
+// 32768 voxels, else kNotFound.
+nlohmann::json precomputed_info(const ArrayWindow& w);
+Result<ChunkBox> precomputed_box(const ArrayWindow& w, int scale, const std::string& name);
+
+// Chunk bytes in C order (c, z, y, x) (Neuroglancer raw: x fastest, channel slowest) from the
+// sRGB8 samples of `voxels` voxels in target order (x fastest, then y, then z; three bytes each).
+std::string chunk_bytes(const std::vector<uint8_t>& srgb_zyxc, int64_t voxels);
 // zstd at level 3, one frame with its content size (what numcodecs' Zstd decodes).
 Result<std::string> zstd_compress(const std::string& bytes);
 

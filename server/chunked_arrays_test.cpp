@@ -46,7 +46,7 @@ TEST(ChunkedArrays, ChunkBytesAreChannelMajorAndZstdRoundTrips) {
   std::vector<uint8_t> zyxc;
   for (int i = 0; i < n * n * n; ++i)
     for (int c = 0; c < 3; ++c) zyxc.push_back(uint8_t(10 * c + i));
-  const std::string bytes = chunk_bytes(zyxc, n);
+  const std::string bytes = chunk_bytes(zyxc, n * n * n);
   ASSERT_EQ(bytes.size(), 24u);
   for (int c = 0; c < 3; ++c)
     for (int i = 0; i < 8; ++i) EXPECT_EQ(uint8_t(bytes[size_t(c * 8 + i)]), uint8_t(10 * c + i));
@@ -55,6 +55,25 @@ TEST(ChunkedArrays, ChunkBytesAreChannelMajorAndZstdRoundTrips) {
   std::string back(24, '\0');
   ASSERT_EQ(ZSTD_decompress(back.data(), back.size(), z.data(), z.size()), 24u);
   EXPECT_EQ(back, bytes);
+}
+
+TEST(ChunkedArrays, PrecomputedNamesBoxesInsideTheScaleOnly) {
+  const ArrayWindow w{3, 128};
+  const auto info = precomputed_info(w);
+  ASSERT_EQ(info["scales"].size(), 3u);
+  EXPECT_EQ(info["num_channels"], 3);
+  EXPECT_EQ(info["scales"][1]["size"], nlohmann::json({64, 64, 64}));
+  EXPECT_EQ(info["scales"][1]["resolution"], nlohmann::json({2, 2, 2}));
+  auto b = precomputed_box(w, 0, "64-128_0-8_32-96");
+  ASSERT_TRUE(b.is_ok()) << b.status().to_string();
+  EXPECT_EQ(b->min, (Voxel{64, 0, 32}));
+  EXPECT_EQ(b->size, (std::array<int, 3>{64, 8, 64}));
+  EXPECT_TRUE(precomputed_box(w, 1, "32-64_32-64_32-64").is_ok());
+  for (const char* bad : {"0-32_0-32_0-33x", "0-32_0-32", "32-0_0-8_0-8", "0-65_0-8_0-8", "0-64_0-64_0-64", "96-160_0-8_0-8",
+                          "-8-0_0-8_0-8", "0-32_0-32_0-32 ", "a-b_c-d_e-f"})
+    EXPECT_EQ(precomputed_box(w, 0, bad).status().code(), StatusCode::kNotFound) << bad;
+  EXPECT_EQ(precomputed_box(w, 1, "64-96_0-32_0-32").status().code(), StatusCode::kNotFound);  // scale 1 is 64 wide
+  EXPECT_EQ(precomputed_box(w, 3, "0-32_0-32_0-32").status().field(), "scale");
 }
 
 }  // namespace

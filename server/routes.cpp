@@ -44,6 +44,8 @@ const std::vector<Route>& route_table() {
       {"GET", "/v1/volumes/{id}/zarr2/.zattrs", E::kWorker, &Api::zarr2_attributes},
       {"GET", "/v1/volumes/{id}/zarr2/{scale}/.zarray", E::kWorker, &Api::zarr2_array},
       {"GET", "/v1/volumes/{id}/zarr2/{scale}/{c}/{cz}/{cy}/{cx}", E::kWorker, &Api::zarr2_chunk},
+      {"GET", "/v1/volumes/{id}/precomputed/info", E::kWorker, &Api::precomputed_info},
+      {"GET", "/v1/volumes/{id}/precomputed/{scale}/{chunk}", E::kWorker, &Api::precomputed_chunk},
   };
   return routes;
 }

@@ -75,6 +75,27 @@ def test_tensorstore_reads_the_same_voxels_in_both_formats(volume):
         assert np.array_equal(got, want), driver
 
 
+def test_precomputed_raw_chunks_are_the_zarr_chunks_uncompressed(volume):
+    srv, vid, _ = volume
+    base = f"{srv.url}/v1/volumes/{vid}/precomputed"
+    info = requests.get(f"{base}/info", timeout=60).json()
+    assert info["@type"] == "neuroglancer_multiscale_volume" and info["num_channels"] == 3
+    assert [s["key"] for s in info["scales"]] == ["0", "1", "2"]
+    assert info["scales"][0]["size"] == [EXTENT] * 3 and [64, 64, 8] in info["scales"][0]["chunk_sizes"]
+    # a 32^3 chunk: x fastest, channel slowest == the C-order (c, z, y, x) zarr chunk
+    raw = requests.get(f"{base}/0/64-96_32-64_0-32", timeout=120)
+    assert raw.status_code == 200 and raw.headers["Access-Control-Allow-Origin"] == "*"
+    v3 = zarr.open_group(f"{srv.url}/v1/volumes/{vid}/zarr", mode="r", zarr_format=3)
+    assert raw.content == v3["0"][:, 0:32, 32:64, 64:96].tobytes()
+    # a flat slab for 2-D views, and a coarser scale
+    flat = np.frombuffer(requests.get(f"{base}/0/0-64_64-128_8-16", timeout=120).content, np.uint8).reshape(3, 8, 64, 64)
+    assert np.array_equal(flat, region_czyx(srv, vid, (8, 64, 0), (16, 128, 64)))
+    coarse = requests.get(f"{base}/1/0-32_0-32_32-64", timeout=120).content
+    assert coarse == v3["1"][:, 32:64, 0:32, 0:32].tobytes()
+    for bad in ("0/0-65_0-8_0-8", "0/0-64_0-64_0-64", "0/120-136_0-8_0-8", "0/0-8_0-8", "1/64-96_0-32_0-32", "3/0-8_0-8_0-8"):
+        assert requests.get(f"{base}/{bad}", timeout=60).status_code == 404, bad
+
+
 def test_zarr2_mirror_reads_the_same_voxels(volume):
     srv, vid, _ = volume
     group = zarr.open_group(f"{srv.url}/v1/volumes/{vid}/zarr2", mode="r", zarr_format=2)
