@@ -8,7 +8,7 @@ import pytest
 import requests
 
 from solidtex_client import BadRequest, Unprocessable
-from support import RAW, assert_error, file_pixels, png_pixels, run_cli, srgb8
+from support import RAW, assert_error, file_pixels, png_pixels, run_cli, solidtex_bin, srgb8
 
 OBLIQUE = dict(origin=(1, 2, 3), u=(0.6, 0.8, 0), v=(-0.48, 0.36, 0.8), size=(32, 24))
 
@@ -53,6 +53,25 @@ def test_slice_variants_agree_and_match_cli(shared, tmp_path):
     run_cli("slice", shared.table_path, "--axis", "z", "--at", "3", "--size", "32,24",
             "--seed", "7", "-o", out)
     assert np.array_equal(file_pixels(out), png_pixels(png)), "service slice != CLI slice"
+
+
+def test_cli_color_and_finest_subpass_flags_match_the_service(shared, tmp_path):
+    # the CLI's --color and --finest-subpass-size at both of their values give the service's
+    # bits for a volume with the same params; other values are errors naming the flag
+    import subprocess
+    c = shared.client
+    for color, s in (("mean", 2), ("medoid", 1), ("mean", 1), ("medoid", 2)):
+        vid = c.create_volume(exemplar=shared.exemplar_id, seed=7, params={"color": color, "finest_subpass_size": s})["id"]
+        out = tmp_path / f"{color}{s}.png"
+        run_cli("slice", shared.table_path, "--axis", "z", "--at", "3", "--size", "16,12", "--seed", "7",
+                "--color", color, "--finest-subpass-size", s, "-o", out)
+        assert np.array_equal(file_pixels(out), c.slice(vid, "z", 3, (16, 12))), (color, s)
+    for flag, bad, named in (("--color", "median", "color: unknown color 'median'"),
+                             ("--finest-subpass-size", "3", "--finest-subpass-size: is 3"),
+                             ("--finest-subpass-size", "0", "--finest-subpass-size: is 0")):
+        proc = subprocess.run([str(solidtex_bin()), "slice", str(shared.table_path), "--axis", "z", "--at", "0",
+                               "--size", "4,4", flag, bad, "-o", str(tmp_path / "x.png")], capture_output=True, text=True)
+        assert proc.returncode != 0 and named in proc.stderr, proc.stderr
 
 
 def test_default_answer_is_png(shared):
