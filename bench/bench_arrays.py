@@ -12,7 +12,6 @@ Usage: bench/bench_arrays.py BUILD [--exemplar PNG]
 """
 import argparse
 import json
-import socket
 import subprocess
 import tempfile
 import threading
@@ -21,18 +20,9 @@ from pathlib import Path
 
 import requests
 
+from http_bench import percentile, run_threads, start_server
+
 REPO = Path(__file__).resolve().parents[1]
-
-
-def free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-def percentile(values, p):
-    v = sorted(values)
-    return v[min(len(v) - 1, int(round(p / 100 * (len(v) - 1))))]
 
 
 def timed_get(url):
@@ -56,17 +46,8 @@ def main():
             subprocess.run([str(binary), "exemplar", "pebbles", "--size", "128,128", "-o", str(exemplar)], check=True,
                            capture_output=True)
         out["exemplar"] = exemplar.name
-        port = free_port()
-        proc = subprocess.Popen([str(binary), "serve", "--port", str(port), "--data", str(Path(tmp) / "data"),
-                                 "--cache-mb", "1024"], stderr=subprocess.DEVNULL)
-        url = f"http://127.0.0.1:{port}"
+        proc, url = start_server(binary, Path(tmp) / "data", "--cache-mb", "1024")
         try:
-            for _ in range(300):
-                try:
-                    if requests.get(url + "/healthz", timeout=1).status_code == 200:
-                        break
-                except requests.RequestException:
-                    time.sleep(0.1)
             up = requests.post(url + "/v1/exemplars", data=exemplar.read_bytes(),
                                headers={"Content-Type": "application/octet-stream"}, timeout=60).json()
             while (job := requests.get(f"{url}/v1/jobs/{up['job']['id']}", timeout=60).json())["state"] not in ("succeeded", "failed"):
@@ -91,13 +72,7 @@ def main():
                     with lock:
                         latencies.append((dt, r.status_code))
 
-            t0 = time.monotonic()
-            threads = [threading.Thread(target=client, args=(i,)) for i in range(8)]
-            for t in threads:
-                t.start()
-            for t in threads:
-                t.join()
-            wall = time.monotonic() - t0
+            wall = run_threads(8, client)
             ms = [d * 1000 for d, _ in latencies]
             out["cached_chunk_ms"] = {"clients": 8, "requests": len(ms), "p50": round(percentile(ms, 50), 2),
                                       "p99": round(percentile(ms, 99), 2), "requests_per_second": round(len(ms) / wall, 1),

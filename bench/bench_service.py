@@ -14,7 +14,6 @@ Usage: bench/bench_service.py [BUILD_DIR]
 """
 import json
 import os
-import socket
 import struct
 import subprocess
 import sys
@@ -25,34 +24,15 @@ from pathlib import Path
 
 import requests
 
+from http_bench import percentile, run_threads, start_server
+
 build = Path(sys.argv[1] if len(sys.argv) > 1 else "build").resolve()
 binary = build / "bin" / "solidtex"
 RAW = {"Accept": "application/octet-stream"}
 
 
-def free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
 def start(data, *flags):
-    port = free_port()
-    proc = subprocess.Popen([str(binary), "serve", "--port", str(port), "--data", str(data), *flags],
-                            stderr=subprocess.DEVNULL)
-    url = f"http://127.0.0.1:{port}"
-    for _ in range(300):
-        try:
-            if requests.get(url + "/healthz", timeout=1).status_code == 200:
-                return proc, url
-        except requests.RequestException:
-            time.sleep(0.1)
-    raise SystemExit("server did not start")
-
-
-def percentile(values, p):
-    v = sorted(values)
-    return v[min(len(v) - 1, int(round(p / 100 * (len(v) - 1))))]
+    return start_server(binary, data, *flags)
 
 
 def main():
@@ -88,7 +68,7 @@ def main():
 
             lat, statuses, lock = [], {}, threading.Lock()
 
-            def client():
+            def client(_):
                 s = requests.Session()
                 for _ in range(25):
                     t = time.monotonic()
@@ -97,13 +77,7 @@ def main():
                         lat.append(1000 * (time.monotonic() - t))
                         statuses[code] = statuses.get(code, 0) + 1
 
-            t0 = time.monotonic()
-            threads = [threading.Thread(target=client) for _ in range(8)]
-            for t in threads:
-                t.start()
-            for t in threads:
-                t.join()
-            wall = time.monotonic() - t0
+            wall = run_threads(8, client)
             out["concurrent"] = {"clients": 8, "requests": len(lat), "requests_per_second": round(len(lat) / wall, 1),
                                  "p95_ms": round(percentile(lat, 95), 2), "statuses": statuses}
 
@@ -136,14 +110,9 @@ def main():
                 with lock:
                     statuses[code] = statuses.get(code, 0) + 1
 
-            t0 = time.monotonic()
-            threads = [threading.Thread(target=new_cut, args=(i,)) for i in range(16)]
-            for t in threads:
-                t.start()
-            for t in threads:
-                t.join()
+            seconds = run_threads(16, new_cut)
             out["overload"] = {"requests": 16, "threads": 1, "queue": 2, "statuses": statuses,
-                               "seconds": round(time.monotonic() - t0, 2)}
+                               "seconds": round(seconds, 2)}
         finally:
             proc.terminate()
             proc.wait(30)

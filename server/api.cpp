@@ -61,26 +61,19 @@ std::string floats_to_bytes(const std::vector<std::array<float, 3>>& rgb) {
   return out;
 }
 
-ImageF to_image(const std::vector<std::array<float, 3>>& rgb, int width, int height) {
-  ImageF img(width, height, 3);
-  for (size_t i = 0; i < rgb.size(); ++i)
-    for (int c = 0; c < 3; ++c) img.pixels[i * 3 + size_t(c)] = rgb[i][size_t(c)];
-  return img;
-}
-
 // Encodes colors laid out as `shape` (outermost first, last = 3) in the negotiated form.
 Result<HttpResponse> encode_colors(const std::vector<std::array<float, 3>>& rgb, int width, int height,
                                     const std::string& shape, Encoding enc) {
   HttpResponse out;
   switch (enc) {
     case Encoding::kPng: {
-      SOLIDTEX_ASSIGN_OR_RETURN(auto png, encode_png_srgb8(to_image(rgb, width, height)));
+      SOLIDTEX_ASSIGN_OR_RETURN(auto png, encode_png_srgb8(rgb_image(rgb, width, height)));
       out.content_type = "image/png";
       out.body.assign(png.begin(), png.end());
       return out;
     }
     case Encoding::kRgb8: {
-      const std::vector<uint8_t> px = to_srgb8(to_image(rgb, width, height));
+      const std::vector<uint8_t> px = to_srgb8(rgb_image(rgb, width, height));
       out.content_type = "application/octet-stream";
       out.body.assign(px.begin(), px.end());
       out.headers.push_back({"X-Dtype", "uint8"});

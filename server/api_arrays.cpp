@@ -143,10 +143,8 @@ Result<HttpResponse> Api::serve_box(const HttpRequest& r, const ArrayView& view,
     auto qr = query_volume(r, "chunk", target, std::nullopt, view.window.scales - 1 - scale);
     if (!qr) return qr.status();
     synthesized = qr->voxels_synthesized;
-    ImageF img(box.size[0], box.size[1] * box.size[2], 3);
-    for (size_t i = 0; i < qr->rgb.size(); ++i)
-      for (size_t k = 0; k < 3; ++k) img.pixels[i * 3 + k] = qr->rgb[i][k];
-    std::string bytes = chunk_bytes(to_srgb8(img), int64_t(qr->rgb.size()));
+    std::string bytes =
+        chunk_bytes(to_srgb8(rgb_image(qr->rgb, box.size[0], box.size[1] * box.size[2])), int64_t(qr->rgb.size()));
     if (zstd) {
       SOLIDTEX_ASSIGN_OR_RETURN(bytes, zstd_compress(bytes));
     }

@@ -676,9 +676,6 @@ Result<VolumeService::ArrayInfo> VolumeService::array_info(const std::string& id
 
 Result<QueryResult> VolumeService::query(const std::string& id, const std::string& kind, const TargetSet& target,
                                          Interrupter& interrupter, int level) {
-  // --max-voxels bounds the sizes clients choose; a chunk of the array views is their fixed
-  // 32^3 unit (still bounded by --max-request-mb), which every array client must be able to read.
-  if (kind != "chunk") SOLIDTEX_RETURN_IF_ERROR(check_target_size(int64_t(target.sample.size()), "size"));
   SOLIDTEX_ASSIGN_OR_RETURN(const Impl::Hold held, impl_->hold(id));
   const auto& v = held.volume;
   const auto& state = held.state;

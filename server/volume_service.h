@@ -62,10 +62,10 @@ class VolumeService {
   Status remove(const std::string& id);
   bool uses_exemplar(const std::string& exemplar_id) const;
 
-  // kUnprocessable when the target has more samples than --max-voxels (checked by callers
-  // before building big targets too, see check_target_size).
+  // Bounded by --max-request-mb (kUnprocessable). --max-voxels bounds the sizes clients choose:
+  // the handlers check it (check_target_size, naming their field) before building a target; the
+  // array views' chunks are their fixed 32^3 unit, which every array client must be able to read.
   // `level`: the pyramid level of the target's voxels (SynthesisOptions::level; -1 finest).
-  // Kind "chunk" (the array views' fixed 32^3 unit) is not bound by --max-voxels.
   Result<QueryResult> query(const std::string& id, const std::string& kind, const TargetSet& target,
                             Interrupter& interrupter, int level = -1);
   // What the chunked-array views need: the synthesis levels served (region volumes serve the

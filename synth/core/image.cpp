@@ -4,6 +4,13 @@
 
 namespace solidtex {
 
+ImageF rgb_image(const std::vector<std::array<float, 3>>& rgb, int width, int height) {
+  ImageF img(width, height, 3);
+  for (size_t i = 0; i < rgb.size() && i < img.pixels.size() / 3; ++i)
+    for (size_t c = 0; c < 3; ++c) img.pixels[i * 3 + c] = rgb[i][c];
+  return img;
+}
+
 CoordinateTriple shift_triple(const CoordinateTriple& t, const int d[3], const std::array<const ImageF*, kNumPlanes>& planes) {
   CoordinateTriple out;
   for (int k = 0; k < kNumPlanes; ++k) {

@@ -40,6 +40,10 @@ CoordinateTriple shift_triple(const CoordinateTriple& t, const int d[3], const s
 // Swaps the axes: out(x, y) = in(y, x).
 ImageF transposed(const ImageF& in);
 
+// A 3-channel width x height image of `rgb` samples in row order (synthesis answers: a cut's
+// pixels, or a box's voxels with height = H * D).
+ImageF rgb_image(const std::vector<std::array<float, 3>>& rgb, int width, int height);
+
 // sRGB transfer curve, per channel value in [0, 1].
 float srgb_to_linear(float v);
 float linear_to_srgb(float v);

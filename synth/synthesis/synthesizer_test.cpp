@@ -57,13 +57,6 @@ std::vector<std::array<float, 3>> cut(Synthesizer& s, char axis, int at, int u, 
   return r.is_ok() ? *r : std::vector<std::array<float, 3>>{};
 }
 
-ImageF to_image(const std::vector<std::array<float, 3>>& rgb, int w, int h) {
-  ImageF img(w, h, 3);
-  for (size_t i = 0; i < rgb.size(); ++i)
-    for (int c = 0; c < 3; ++c) img.pixels[i * 3 + size_t(c)] = rgb[i][size_t(c)];
-  return img;
-}
-
 class SynthesizerTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() { table_ = small_table(ProceduralKind::kSpots, false); }
@@ -298,7 +291,7 @@ TEST_F(SynthesizerTest, CorrectionLowersMatchingEnergyAndDualGridKeepsQuality) {
     auto s = make(table_, "identity", p, 0);
     double e = 0;
     for (char axis : {'x', 'y', 'z'}) {
-      const double ea = neighborhood_energy(to_image(cut(*s, axis, 5, 0, 0, 40, 40), 40, 40), exemplar, 7, 2);
+      const double ea = neighborhood_energy(rgb_image(cut(*s, axis, 5, 0, 0, 40, 40), 40, 40), exemplar, 7, 2);
       e += ea / 3;
     }
     return e;
@@ -352,7 +345,7 @@ TEST(SynthesizerQuality, CutsAreCrispAndCoverTheExemplarUnlikeABlurredCopy) {
     auto s = make(table, "identity", p, 0);
     cov = 0, min_sharp = 1e9, max_sharp = 0;
     for (char axis : {'x', 'y', 'z'}) {
-      const ImageF img = to_image(cut(*s, axis, 5, 0, 0, 40, 40), 40, 40);
+      const ImageF img = rgb_image(cut(*s, axis, 5, 0, 0, 40, 40), 40, 40);
       cov = std::max(cov, coverage(img, exemplar, 7, 2));
       min_sharp = std::min(min_sharp, sharpness_ratio(img, exemplar));
       max_sharp = std::max(max_sharp, sharpness_ratio(img, exemplar));
@@ -397,7 +390,7 @@ TEST(SynthesizerQuality, MedoidColorsAreExemplarColorsAndNoBlurrierThanMeans) {
     for (char axis : {'x', 'z'}) {
       const auto rgb = cut(*s, axis, 7, 0, 0, 40, 40);
       share = std::min(share, share_of_exemplar_colors(rgb));
-      sharp += sharpness_ratio(to_image(rgb, 40, 40), exemplar) / 2;
+      sharp += sharpness_ratio(rgb_image(rgb, 40, 40), exemplar) / 2;
     }
   };
   double share_medoid = 0, sharp_medoid = 0, share_mean = 0, sharp_mean = 0;
@@ -452,7 +445,7 @@ TEST(SynthesizerQuality, XAndYCutsAreNotStreakedAlongZ) {
     for (char axis : {'x', 'y'})
       for (int at : {0, 21}) {
         // Axis cuts put z on the image's y: pixel (i, j) is voxel (at, i, j) or (i, at, j).
-        const ImageF img = to_image(cut(*s, axis, at, 0, 0, 48, 48), 48, 48);
+        const ImageF img = rgb_image(cut(*s, axis, at, 0, 0, 48, 48), 48, 48);
         sum += -streak_along_x(img, 4);
         ++n;
       }
@@ -471,7 +464,7 @@ TEST(SynthesizerOrientation, ConstantRotationTurnsTheGrain) {
   SynthesisParams p = small_params();
   auto angle = [&](const std::string& field) {
     auto s = make(table, field, p, 0);
-    return dominant_orientation_degrees(to_image(cut(*s, 'z', 0, 0, 0, 48, 48), 48, 48));
+    return dominant_orientation_degrees(rgb_image(cut(*s, 'z', 0, 0, 0, 48, 48), 48, 48));
   };
   const double straight = angle("identity");
   const double turned = angle("axis:0,0,1,45");

@@ -122,25 +122,22 @@ def test_volumes_stored_before_a_default_changed_keep_their_voxels(server, exemp
     want_recent = c.slice(eight["id"], "z", 2, (24, 24))
     assert not np.array_equal(c.slice(recent["id"], "z", 2, (24, 24)), want_recent), "subpasses changed nothing"
     assert a.stop(grace=10) == 0
-    path = next(p for p in a.data_dir.rglob("volume.json") if vol["id"] in str(p))
-    info = json.loads(path.read_text())
-    del info["params"], info["spec"]["params"]
-    path.write_text(json.dumps(info))
-    path = next(p for p in a.data_dir.rglob("volume.json") if middle["id"] in str(p))
-    info = json.loads(path.read_text())
-    for params in (info["params"], info["spec"]["params"]):
-        del params["init"], params["color"], params["finest_subpass_size"]
-    path.write_text(json.dumps(info))
-    path = next(p for p in a.data_dir.rglob("volume.json") if late["id"] in str(p))
-    info = json.loads(path.read_text())
-    for params in (info["params"], info["spec"]["params"]):
-        del params["color"], params["finest_subpass_size"]
-    path.write_text(json.dumps(info))
-    path = next(p for p in a.data_dir.rglob("volume.json") if recent["id"] in str(p))
-    info = json.loads(path.read_text())
-    for params in (info["params"], info["spec"]["params"]):
-        del params["finest_subpass_size"]
-    path.write_text(json.dumps(info))
+    def forget(volume_id, *keys):
+        """Rewrites the stored volume.json as a release that did not pin `keys` wrote it (no
+        keys: one that stored no params at all)."""
+        path = next(p for p in a.data_dir.rglob("volume.json") if volume_id in str(p))
+        info = json.loads(path.read_text())
+        if not keys:
+            del info["params"], info["spec"]["params"]
+        for params in (info["params"], info["spec"]["params"]) if keys else ():
+            for key in keys:
+                del params[key]
+        path.write_text(json.dumps(info))
+
+    forget(vol["id"])
+    forget(middle["id"], "init", "color", "finest_subpass_size")
+    forget(late["id"], "color", "finest_subpass_size")
+    forget(recent["id"], "finest_subpass_size")
     b = server(data_dir=a.data_dir)
     got = b.client.get_volume(vol["id"])
     assert got["params"] == {"typicality": 0, "passes": 2, "init": "slab", "color": "mean", "finest_subpass_size": 2}, got

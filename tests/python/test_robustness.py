@@ -92,61 +92,46 @@ def test_an_empty_timeout_is_an_error_not_the_default(srv):
     alive(srv)
 
 
-def test_init_takes_its_three_names_only(srv):
-    # auto (the default, pinned when absent), scatter and slab synthesize; the procedural wood
-    # is analysed as grain x (three planes), where auto is slab; anything else is a 400 naming
-    # the field (on a one-image exemplar auto is scatter, unlike slab: test_persistence.py)
+def takes_its_values_only(srv, key, values, default, bad):
+    """Every documented value of volume param `key` creates a volume that synthesizes (slices
+    returned by value); the default is pinned when absent; each of `bad` is a 400 naming
+    params.`key`; the process stays up."""
     cuts = {}
-    for value in ("auto", "scatter", "slab"):
-        r = create_volume(srv, params={"init": value})
+    for value in values:
+        r = create_volume(srv, params={key: value})
         assert r.status_code == 201, r.text
-        assert r.json()["params"]["init"] == value
+        assert r.json()["params"][key] == value
         got = slice_of(srv, r.json()["id"], size="8,8")
         assert got.status_code == 200, got.text
         cuts[value] = got.content
+    assert create_volume(srv).json()["params"][key] == default
+    for value in bad:
+        assert_error(create_volume(srv, params={key: value}), 400, "invalid_argument", f"params.{key}")
+    alive(srv)
+    return cuts
+
+
+def test_init_takes_its_three_names_only(srv):
+    # auto (the default, pinned when absent), scatter and slab synthesize; the procedural wood
+    # is analysed as grain x (three planes), where auto is slab (on a one-image exemplar auto
+    # is scatter, unlike slab: test_persistence.py)
+    cuts = takes_its_values_only(srv, "init", ("auto", "scatter", "slab"), "auto",
+                                 ("random", "Slab", "", 1, None, ["slab"]))
     assert cuts["scatter"] != cuts["slab"]
     assert cuts["auto"] == cuts["slab"]
-    assert create_volume(srv).json()["params"]["init"] == "auto"
-    for value in ("random", "Slab", "", 1, None, ["slab"]):
-        assert_error(create_volume(srv, params={"init": value}), 400, "invalid_argument", "params.init")
-    alive(srv)
 
 
 def test_finest_subpass_size_takes_1_and_2_only(srv):
-    # both ends of the documented range synthesize and differ; the default 1 is pinned when
-    # absent; anything else is a 400 naming the field
-    cuts = {}
-    for value in (1, 2):
-        r = create_volume(srv, params={"finest_subpass_size": value})
-        assert r.status_code == 201, r.text
-        assert r.json()["params"]["finest_subpass_size"] == value
-        got = slice_of(srv, r.json()["id"], size="8,8")
-        assert got.status_code == 200, got.text
-        cuts[value] = got.content
+    # both ends of the documented range synthesize and differ; the default is 1
+    cuts = takes_its_values_only(srv, "finest_subpass_size", (1, 2), 1, (0, 3, -1, 1.5, "1", None, [1]))
     assert cuts[1] != cuts[2]
-    assert create_volume(srv).json()["params"]["finest_subpass_size"] == 1
-    for value in (0, 3, -1, 1.5, "1", None, [1]):
-        assert_error(create_volume(srv, params={"finest_subpass_size": value}), 400, "invalid_argument",
-                     "params.finest_subpass_size")
-    alive(srv)
 
 
 def test_color_takes_its_two_names_only(srv):
-    # medoid (the default, pinned when absent) and mean synthesize the same triples and differ
-    # in colors only; anything else is a 400 naming the field
-    cuts = {}
-    for value in ("medoid", "mean"):
-        r = create_volume(srv, params={"color": value})
-        assert r.status_code == 201, r.text
-        assert r.json()["params"]["color"] == value
-        got = slice_of(srv, r.json()["id"], size="8,8")
-        assert got.status_code == 200, got.text
-        cuts[value] = got.content
+    # medoid (the default) and mean synthesize the same triples and differ in colors only
+    cuts = takes_its_values_only(srv, "color", ("medoid", "mean"), "medoid",
+                                 ("median", "Mean", "", 0, None, ["mean"], {"rule": "mean"}))
     assert cuts["medoid"] != cuts["mean"]
-    assert create_volume(srv).json()["params"]["color"] == "medoid"
-    for value in ("median", "Mean", "", 0, None, ["mean"], {"rule": "mean"}):
-        assert_error(create_volume(srv, params={"color": value}), 400, "invalid_argument", "params.color")
-    alive(srv)
 
 
 @pytest.mark.parametrize("spec", ["identity;scale:2.1,1,1", "axis:0,0,1,30;scale:3,1,1"])
