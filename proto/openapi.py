@@ -56,11 +56,26 @@ E = {"400": err("Malformed request: bad JSON, unknown key or query parameter, va
 def errs(*codes): return {c: E[c] for c in codes}
 # Chunked-array views (server/chunked_arrays.h): every answer carries CORS headers.
 CORS = {"Access-Control-Allow-Origin": {"schema": {"type": "string"}}, "Access-Control-Expose-Headers": {"schema": {"type": "string"}}}
-ZARR_META = {"description": "Metadata (JSON).", "headers": {**CORS, "ETag": {"schema": {"type": "string"}}, "Cache-Control": {"schema": {"type": "string"}}},
+# Their successful answers are conditional and ranged (server/conditional_get.h): HEAD (as on
+# every GET route), If-None-Match with the ETag -> 304, a single `Range: bytes=a-b | a- | -n` ->
+# 206 or 416; other Range forms (several ranges, other units) are ignored: 200 with everything.
+RANGED = ("HEAD answers the same status and headers without the body. `If-None-Match` naming the ETag: 304. "
+          "A single `Range: bytes=a-b`, `bytes=a-` or `bytes=-n` (with an `If-Range` naming the ETag, if any): 206 with those bytes "
+          "and `Content-Range: bytes a-b/total`, or 416 with `Content-Range: bytes */total` when it starts past the end; "
+          "several ranges, other units and malformed headers are ignored (200, the whole body). Every 200 says `Accept-Ranges: bytes`.")
+STR = {"schema": {"type": "string"}}
+ARRAY_HEADERS = {**CORS, "ETag": STR, "Cache-Control": STR, "Accept-Ranges": STR}
+ZARR_META = {"description": "Metadata (JSON).", "headers": ARRAY_HEADERS,
              "content": {"application/json": {"schema": {"type": "object"}}}}
 ZARR_CHUNK_OUT = {"description": "zstd-compressed chunk bytes; a strong ETag from (volume spec, format, dataset, chunk), stable across restarts; Cache-Control: public, max-age=31536000, immutable.",
-                  "headers": {**CORS, "ETag": {"schema": {"type": "string"}}, "Cache-Control": {"schema": {"type": "string"}}, "X-Voxels-Synthesized": {"schema": {"type": "integer"}}},
+                  "headers": {**ARRAY_HEADERS, "X-Voxels-Synthesized": {"schema": {"type": "integer"}}},
                   "content": {"application/octet-stream": {"schema": {"type": "string", "format": "binary"}}}}
+RANGE_OUT = {"206": {"description": "Partial content: the requested bytes of the 200 body (Range).", "headers": {**ARRAY_HEADERS, "Content-Range": STR}},
+             "304": {"description": "Not modified: If-None-Match named the ETag; no body.", "headers": {**CORS, "ETag": STR, "Cache-Control": STR}},
+             "416": {**err("Range not satisfiable: the range starts past the end (`Content-Range: bytes */total`)."), "headers": {**CORS, "Content-Range": STR}}}
+def array_op(op_id, summary, ok, codes):
+    return {"operationId": op_id, "summary": summary, "description": RANGED, "responses": {"200": ok, **RANGE_OUT, **errs(*codes)}}
+PRECOMPUTED_CHUNK = {"name": "chunk", "in": "path", "required": True, "description": "x0-x1_y0-y1_z0-z1 voxel bounds of the scale: inside it, at most 64 a side and 32768 voxels (else 404).", "schema": {"type": "string", "pattern": "^[0-9]+-[0-9]+_[0-9]+-[0-9]+_[0-9]+-[0-9]+$"}}
 def zarr_index(name, desc):
     return {"name": name, "in": "path", "required": True, "description": desc + " Past the array (or not an index): 404.", "schema": {"type": "integer", "minimum": 0}}
 ZARR_SCALE = zarr_index("scale", "Dataset: 0 is the finest synthesis level, s has voxels 2^s finest voxels wide.")
@@ -309,33 +324,38 @@ paths = {
      "requestBody": {"required": True, "content": {"application/json": {"schema": ref("FieldFromMesh")}}},
      "responses": {"201": created(ref("Field"), links_to(FIELD_OPS)), **errs("400", "404", "413", "415", "422", "503", "504")}}},
  "/v1/volumes/{id}/zarr/zarr.json": {"parameters": [pid()],
-   "get": {"operationId": "zarr_group", "summary": "OME-Zarr 0.5 (Zarr v3) group of the volume: `attributes.ome.multiscales` with one dataset per synthesis level (dataset s = synthesis level L-1-s, scale 2^s; levels are synthesis levels, not box filters; region volumes serve the finest only) and inline consolidated metadata. The arrays are [c, z, y, x] uint8 sRGB windows of --array-extent^3 finest voxels from the origin, chunks [3, 32, 32, 32], zstd. Open it with zarr-python: `zarr.open_group(URL, mode='r')`.",
-     "responses": {"200": ZARR_META, **errs("400", "404", "503")}}},
+   "get": array_op("zarr_group", "OME-Zarr 0.5 (Zarr v3) group of the volume: `attributes.ome.multiscales` with one dataset per synthesis level (dataset s = synthesis level L-1-s, scale 2^s; levels are synthesis levels, not box filters; region volumes serve the finest only) and inline consolidated metadata. The arrays are [c, z, y, x] uint8 sRGB windows of --array-extent^3 finest voxels from the origin, chunks [3, 32, 32, 32], zstd. Open it with zarr-python: `zarr.open_group(URL, mode='r')`, in Neuroglancer as `zarr3://URL/` (without zarr.json).",
+                   ZARR_META, ("400", "404", "503"))},
  "/v1/volumes/{id}/zarr/{scale}/zarr.json": {"parameters": [pid(), ZARR_SCALE],
-   "get": {"operationId": "zarr_array", "summary": "Zarr v3 array metadata of dataset `scale`.", "responses": {"200": ZARR_META, **errs("400", "404", "503")}}},
+   "get": array_op("zarr_array", "Zarr v3 array metadata of dataset `scale`.", ZARR_META, ("400", "404", "503"))},
  "/v1/volumes/{id}/zarr/{scale}/c/{c}/{cz}/{cy}/{cx}": {"parameters": [pid(), ZARR_SCALE, *ZARR_CHUNK],
-   "get": {"operationId": "zarr_chunk", "summary": "One chunk (default chunk-key encoding), synthesized when first asked for: zstd-compressed bytes of a C-order (c, z, y, x) uint8 block, exactly the region endpoint's sRGB voxels of that box at that level. Never 404 for voxels not computed yet; 404 only outside the array.",
-     "responses": {"200": ZARR_CHUNK_OUT, **errs("400", "404", "422", "503", "504")}}},
+   "get": array_op("zarr_chunk", "One chunk (default chunk-key encoding), synthesized when first asked for: zstd-compressed bytes of a C-order (c, z, y, x) uint8 block, exactly the region endpoint's sRGB voxels of that box at that level. Never 404 for voxels not computed yet; 404 only outside the array.",
+                   ZARR_CHUNK_OUT, ("400", "404", "422", "503", "504"))},
  "/v1/volumes/{id}/zarr2/.zgroup": {"parameters": [pid()],
-   "get": {"operationId": "zarr2_group", "summary": "Zarr v2 group of the volume (OME-Zarr 0.4 mirror of /zarr).", "responses": {"200": ZARR_META, **errs("400", "404", "503")}}},
+   "get": array_op("zarr2_group", "Zarr v2 group of the volume (OME-Zarr 0.4 mirror of /zarr).", ZARR_META, ("400", "404", "503"))},
  "/v1/volumes/{id}/zarr2/.zattrs": {"parameters": [pid()],
-   "get": {"operationId": "zarr2_attributes", "summary": "OME-Zarr 0.4 multiscales of the Zarr v2 group.", "responses": {"200": ZARR_META, **errs("400", "404", "503")}}},
+   "get": array_op("zarr2_attributes", "OME-Zarr 0.4 multiscales of the Zarr v2 group.", ZARR_META, ("400", "404", "503"))},
  "/v1/volumes/{id}/zarr2/{scale}/.zarray": {"parameters": [pid(), ZARR_SCALE],
-   "get": {"operationId": "zarr2_array", "summary": "Zarr v2 array metadata of dataset `scale` (dimension separator '/', compressor zstd).", "responses": {"200": ZARR_META, **errs("400", "404", "503")}}},
+   "get": array_op("zarr2_array", "Zarr v2 array metadata of dataset `scale` (dimension separator '/', compressor zstd).", ZARR_META, ("400", "404", "503"))},
  "/v1/volumes/{id}/zarr2/{scale}/{c}/{cz}/{cy}/{cx}": {"parameters": [pid(), ZARR_SCALE, *ZARR_CHUNK],
-   "get": {"operationId": "zarr2_chunk", "summary": "One Zarr v2 chunk: the same bytes as the Zarr v3 chunk at the same indices.",
-     "responses": {"200": ZARR_CHUNK_OUT, **errs("400", "404", "422", "503", "504")}}},
+   "get": array_op("zarr2_chunk", "One Zarr v2 chunk: the same bytes as the Zarr v3 chunk at the same indices.", ZARR_CHUNK_OUT, ("400", "404", "422", "503", "504"))},
  "/v1/volumes/{id}/precomputed/info": {"parameters": [pid()],
-   "get": {"operationId": "precomputed_info", "summary": "Neuroglancer precomputed `info` of the volume: one scale per synthesis level (key s = dataset s of /zarr, resolution 2^s), num_channels 3, uint8, raw encoding; chunk sizes 32^3 and the flat 64x64x8, 64x8x64, 8x64x64 for 2-D views. Open in Neuroglancer as `precomputed://URL` (without /info).",
-     "responses": {"200": ZARR_META, **errs("400", "404", "503")}}},
- "/v1/volumes/{id}/precomputed/{scale}/{chunk}": {"parameters": [pid(), zarr_index("scale", "Scale key (dataset)."),
-     {"name": "chunk", "in": "path", "required": True, "description": "x0-x1_y0-y1_z0-z1 voxel bounds of the scale: inside it, at most 64 a side and 32768 voxels (else 404).", "schema": {"type": "string", "pattern": "^[0-9]+-[0-9]+_[0-9]+-[0-9]+_[0-9]+-[0-9]+$"}}],
-   "get": {"operationId": "precomputed_chunk", "summary": "One raw chunk: uint8 sRGB, x fastest, channel slowest (the bytes of a C-order (c, z, y, x) Zarr chunk of the same box, uncompressed).",
-     "responses": {"200": ZARR_CHUNK_OUT, **errs("400", "404", "422", "503", "504")}}},
+   "get": array_op("precomputed_info", "Neuroglancer precomputed `info` of the volume: one scale per synthesis level (key s = dataset s of /zarr, resolution 2^s), num_channels 3, uint8, raw encoding; chunk sizes 32^3 and the flat 64x64x8, 64x8x64, 8x64x64 for 2-D views. Open in Neuroglancer as `precomputed://URL` (without /info).",
+                   ZARR_META, ("400", "404", "503"))},
+ "/v1/volumes/{id}/precomputed/{scale}/{chunk}": {"parameters": [pid(), zarr_index("scale", "Scale key (dataset)."), PRECOMPUTED_CHUNK],
+   "get": array_op("precomputed_chunk", "One raw chunk: uint8 sRGB, x fastest, channel slowest (the bytes of a C-order (c, z, y, x) Zarr chunk of the same box, uncompressed).",
+                   ZARR_CHUNK_OUT, ("400", "404", "422", "503", "504"))},
+ "/v1/volumes/{id}/precomputed-jpeg/info": {"parameters": [pid()],
+   "get": array_op("precomputed_jpeg_info", "The precomputed `info` of /precomputed with `\"encoding\": \"jpeg\"` in every scale: lossy chunks several times smaller than raw, for viewing over slow links. Open in Neuroglancer as `precomputed://URL` (without /info).",
+                   ZARR_META, ("400", "404", "503"))},
+ "/v1/volumes/{id}/precomputed-jpeg/{scale}/{chunk}": {"parameters": [pid(), zarr_index("scale", "Scale key (dataset)."), PRECOMPUTED_CHUNK],
+   "get": array_op("precomputed_jpeg_chunk", "One jpeg chunk (Neuroglancer's jpeg encoding): a baseline JPEG (quality 90, 4:4:4) of width x and height y*z, the chunk's z slices stacked top to bottom, RGB; the voxels of the raw chunk of the same name up to JPEG loss. Its ETag differs from the raw chunk's.",
+                   {**ZARR_CHUNK_OUT, "description": "JPEG bytes; strong ETag, immutable like the raw chunks.", "content": {"image/jpeg": {"schema": {"type": "string", "format": "binary"}}}},
+                   ("400", "404", "422", "503", "504"))},
  "/v1/volumes/{id}/stats": {"parameters": [pid()],
    "get": {"operationId": "volume_stats", "summary": "Voxels per level, cache bytes and hits, the loaded state's resident bytes and evictions, the last requests' dependent-set sizes.", "responses": {"200": js(ref("Stats")), **errs("404")}}},
 }
-doc = {"openapi": "3.1.0", "info": {"title": "solidtex", "version": "1.0.0", "description": "Lazy solid-texture volumes (Zhang et al. 2011). Errors always have the shape {\"error\": {\"code\", \"message\", \"field\"}}. Ids are opaque strings. Synthesis requests run on a bounded worker pool: when its queue is full the answer is 503 with Retry-After. World units are finest-level voxels. Query parameters are strict: an unknown or repeated one is refused (400). Lists in the query are comma-separated (`size=64,64`). The limits that depend on flags of `solidtex serve` are given with their defaults; over them the answer is 422 (413 only for a body over --max-upload-mb)."},
+doc = {"openapi": "3.1.0", "info": {"title": "solidtex", "version": "1.0.0", "description": "Lazy solid-texture volumes (Zhang et al. 2011). Errors always have the shape {\"error\": {\"code\", \"message\", \"field\"}}. Ids are opaque strings. Synthesis requests run on a bounded worker pool: when its queue is full the answer is 503 with Retry-After. World units are finest-level voxels. Query parameters are strict: an unknown or repeated one is refused (400). Lists in the query are comma-separated (`size=64,64`). The limits that depend on flags of `solidtex serve` are given with their defaults; over them the answer is 422 (413 only for a body over --max-upload-mb). Every GET route also answers HEAD: the same status and headers (Content-Length of the body GET would send), no body."},
        "paths": paths, "components": {"schemas": S}}
 
 if __name__ == "__main__":

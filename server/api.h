@@ -71,6 +71,8 @@ class Api {
   HttpResponse zarr2_chunk(const HttpRequest& r);
   HttpResponse precomputed_info(const HttpRequest& r);
   HttpResponse precomputed_chunk(const HttpRequest& r);
+  HttpResponse precomputed_jpeg_info(const HttpRequest& r);
+  HttpResponse precomputed_jpeg_chunk(const HttpRequest& r);
 
  private:
   Result<std::unique_ptr<RequestInterrupter>> interrupter_for(const HttpRequest& r, const std::optional<std::string>& timeout) const;
@@ -89,9 +91,11 @@ class Api {
   };
   Result<ArrayView> array_view(const HttpRequest& r);
   Result<int> dataset_of(const HttpRequest& r, const ArrayView& view);
+  enum class ChunkEncoding { kZstd, kRaw, kJpeg };
   HttpResponse array_chunk(const HttpRequest& r, const std::string& format);  // the same bytes in every format
+  HttpResponse precomputed_chunk_as(const HttpRequest& r, const std::string& format, ChunkEncoding encoding);
   Result<HttpResponse> serve_box(const HttpRequest& r, const ArrayView& view, int scale, const ChunkBox& box,
-                                 const std::string& format, const std::string& key, bool zstd);
+                                 const std::string& format, const std::string& key, ChunkEncoding encoding);
   HttpResponse array_metadata(const HttpRequest& r, const std::function<Result<nlohmann::json>(const ArrayView&)>& make);
   Result<HttpResponse> synthesize_image(const HttpRequest& r, const std::string& kind, const TargetSet& target,
                                         const std::optional<std::string>& timeout);

@@ -1,11 +1,14 @@
 // Handlers of the chunked-array views (chunked_arrays.h): decode the path, ask the volume
 // service, encode. Every answer carries CORS headers (browser viewers read them cross-origin);
 // chunks carry a strong ETag from (volume spec, format, dataset, chunk) and are immutable.
+// Successful answers go through conditional_get (If-None-Match, Range); HEAD is the adapter's.
 #include <charconv>
 
 #include "api.h"
 #include "chunked_arrays.h"
+#include "conditional_get.h"
 #include "core/image_io.h"
+#include "jpeg_chunk.h"
 #include "query_params.h"
 #include "synthesis/target.h"
 
@@ -16,7 +19,8 @@ using nlohmann::json;
 
 void add_cors(HttpResponse& r) {
   r.headers.push_back({"Access-Control-Allow-Origin", "*"});
-  r.headers.push_back({"Access-Control-Expose-Headers", "ETag, Content-Length, X-Voxels-Synthesized"});
+  r.headers.push_back({"Access-Control-Expose-Headers",
+                       "ETag, Content-Length, Content-Range, Accept-Ranges, X-Voxels-Synthesized"});
 }
 
 HttpResponse array_error(const Status& s) {
@@ -56,7 +60,7 @@ HttpResponse Api::array_metadata(const HttpRequest& r, const std::function<Resul
     out.headers.push_back({"ETag", "\"" + view.tag + "-" + std::to_string(view.window.extent) + "-" + r.route + "\""});
     out.headers.push_back({"Cache-Control", "public, max-age=60"});
     add_cors(out);
-    return out;
+    return conditional_get(r, std::move(out));
   }();
   return result ? *result : array_error(result.status());
 }
@@ -112,29 +116,40 @@ HttpResponse Api::array_chunk(const HttpRequest& r, const std::string& format) {
     }
     SOLIDTEX_ASSIGN_OR_RETURN(const ChunkBox box, chunk_box(view.window, scale, czyx));
     const std::string key = std::to_string(czyx[0]) + "." + std::to_string(czyx[1]) + "." + std::to_string(czyx[2]);
-    return serve_box(r, view, scale, box, format, key, /*zstd=*/true);
+    return serve_box(r, view, scale, box, format, key, ChunkEncoding::kZstd);
   }();
   return result ? *result : array_error(result.status());
 }
 
 HttpResponse Api::precomputed_info(const HttpRequest& r) {
-  return array_metadata(r, [](const ArrayView& v) -> Result<json> { return server::precomputed_info(v.window); });
+  return array_metadata(r, [](const ArrayView& v) -> Result<json> { return server::precomputed_info(v.window, "raw"); });
 }
 
-HttpResponse Api::precomputed_chunk(const HttpRequest& r) {
+HttpResponse Api::precomputed_chunk(const HttpRequest& r) { return precomputed_chunk_as(r, "precomputed", ChunkEncoding::kRaw); }
+
+HttpResponse Api::precomputed_jpeg_info(const HttpRequest& r) {
+  return array_metadata(r, [](const ArrayView& v) -> Result<json> { return server::precomputed_info(v.window, "jpeg"); });
+}
+
+HttpResponse Api::precomputed_jpeg_chunk(const HttpRequest& r) {
+  return precomputed_chunk_as(r, "precomputed-jpeg", ChunkEncoding::kJpeg);
+}
+
+HttpResponse Api::precomputed_chunk_as(const HttpRequest& r, const std::string& format, ChunkEncoding encoding) {
   auto result = [&]() -> Result<HttpResponse> {
     SOLIDTEX_ASSIGN_OR_RETURN(const ArrayView view, array_view(r));
     SOLIDTEX_ASSIGN_OR_RETURN(const int scale, dataset_of(r, view));
     SOLIDTEX_ASSIGN_OR_RETURN(const ChunkBox box, precomputed_box(view.window, scale, r.param("chunk")));
-    return serve_box(r, view, scale, box, "precomputed", r.param("chunk"), /*zstd=*/false);
+    return serve_box(r, view, scale, box, format, r.param("chunk"), encoding);
   }();
   return result ? *result : array_error(result.status());
 }
 
-// The voxels of `box` at dataset `scale` as C-order (c, z, y, x) sRGB8, zstd-compressed or raw,
-// from the chunk cache when an earlier request encoded them.
+// The voxels of `box` at dataset `scale`: C-order (c, z, y, x) sRGB8 zstd-compressed or raw, or
+// a jpeg of the z slices stacked (jpeg_chunk.h); from the chunk cache when an earlier request
+// encoded them.
 Result<HttpResponse> Api::serve_box(const HttpRequest& r, const ArrayView& view, int scale, const ChunkBox& box,
-                                    const std::string& format, const std::string& key, bool zstd) {
+                                    const std::string& format, const std::string& key, ChunkEncoding encoding) {
   const std::string etag = "\"" + view.tag + "-" + format + "-" + std::to_string(scale) + "-" + key + "\"";
   int64_t synthesized = 0;
   std::shared_ptr<const std::string> body = chunks_.find(etag);
@@ -143,22 +158,27 @@ Result<HttpResponse> Api::serve_box(const HttpRequest& r, const ArrayView& view,
     auto qr = query_volume(r, "chunk", target, std::nullopt, view.window.scales - 1 - scale);
     if (!qr) return qr.status();
     synthesized = qr->voxels_synthesized;
-    std::string bytes =
-        chunk_bytes(to_srgb8(rgb_image(qr->rgb, box.size[0], box.size[1] * box.size[2])), int64_t(qr->rgb.size()));
-    if (zstd) {
-      SOLIDTEX_ASSIGN_OR_RETURN(bytes, zstd_compress(bytes));
+    const std::vector<uint8_t> srgb = to_srgb8(rgb_image(qr->rgb, box.size[0], box.size[1] * box.size[2]));
+    std::string bytes;
+    if (encoding == ChunkEncoding::kJpeg) {
+      SOLIDTEX_ASSIGN_OR_RETURN(bytes, jpeg_chunk(srgb, box.size[0], box.size[1], box.size[2]));
+    } else {
+      bytes = chunk_bytes(srgb, int64_t(qr->rgb.size()));
+      if (encoding == ChunkEncoding::kZstd) {
+        SOLIDTEX_ASSIGN_OR_RETURN(bytes, zstd_compress(bytes));
+      }
     }
     body = std::make_shared<const std::string>(std::move(bytes));
     chunks_.insert(etag, body);
   }
   HttpResponse out;
-  out.content_type = "application/octet-stream";
+  out.content_type = encoding == ChunkEncoding::kJpeg ? "image/jpeg" : "application/octet-stream";
   out.body = *body;
   out.headers.push_back({"ETag", etag});
   out.headers.push_back({"Cache-Control", "public, max-age=31536000, immutable"});
   out.headers.push_back({"X-Voxels-Synthesized", std::to_string(synthesized)});
   add_cors(out);
-  return out;
+  return conditional_get(r, std::move(out));
 }
 
 }  // namespace solidtex::server

@@ -99,7 +99,7 @@ Result<ChunkBox> chunk_box(const ArrayWindow& w, int scale, const std::array<int
   return ChunkBox{{int(czyx[2] * kArrayChunk), int(czyx[1] * kArrayChunk), int(czyx[0] * kArrayChunk)}};
 }
 
-json precomputed_info(const ArrayWindow& w) {
+json precomputed_info(const ArrayWindow& w, const std::string& encoding) {
   json scales = json::array();
   for (int s = 0; s < w.scales; ++s) {
     const int64_t side = w.side(s), f = int64_t(1) << s;
@@ -108,7 +108,7 @@ json precomputed_info(const ArrayWindow& w) {
                       {"resolution", {f, f, f}},
                       {"voxel_offset", {0, 0, 0}},
                       {"chunk_sizes", {{32, 32, 32}, {64, 64, 8}, {64, 8, 64}, {8, 64, 64}}},
-                      {"encoding", "raw"}});
+                      {"encoding", encoding}});
   }
   return {{"@type", "neuroglancer_multiscale_volume"}, {"type", "image"}, {"data_type", "uint8"}, {"num_channels", 3},
           {"scales", scales}};

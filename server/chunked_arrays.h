@@ -52,10 +52,10 @@ struct ChunkBox {
 Result<ChunkBox> chunk_box(const ArrayWindow& w, int scale, const std::array<int64_t, 3>& czyx);
 
 // Neuroglancer precomputed: the `info` (scale key s = dataset s, resolution 2^s, chunk sizes
-// 32^3 and the flat 64x64x8 with its rotations so 2-D views do not pay for depth, raw encoding),
-// and the box a chunk name "x0-x1_y0-y1_z0-z1" names: inside the dataset, at most 64 a side and
-// 32768 voxels, else kNotFound.
-nlohmann::json precomputed_info(const ArrayWindow& w);
+// 32^3 and the flat 64x64x8 with its rotations so 2-D views do not pay for depth; `encoding`
+// "raw" or "jpeg" for every scale), and the box a chunk name "x0-x1_y0-y1_z0-z1" names: inside
+// the dataset, at most 64 a side and 32768 voxels, else kNotFound.
+nlohmann::json precomputed_info(const ArrayWindow& w, const std::string& encoding);
 Result<ChunkBox> precomputed_box(const ArrayWindow& w, int scale, const std::string& name);
 
 // Chunk bytes in C order (c, z, y, x) (Neuroglancer raw: x fastest, channel slowest) from the

@@ -59,8 +59,10 @@ TEST(ChunkedArrays, ChunkBytesAreChannelMajorAndZstdRoundTrips) {
 
 TEST(ChunkedArrays, PrecomputedNamesBoxesInsideTheScaleOnly) {
   const ArrayWindow w{3, 128};
-  const auto info = precomputed_info(w);
+  const auto info = precomputed_info(w, "raw");
   ASSERT_EQ(info["scales"].size(), 3u);
+  EXPECT_EQ(info["scales"][2]["encoding"], "raw");
+  EXPECT_EQ(precomputed_info(w, "jpeg")["scales"][0]["encoding"], "jpeg");
   EXPECT_EQ(info["num_channels"], 3);
   EXPECT_EQ(info["scales"][1]["size"], nlohmann::json({64, 64, 64}));
   EXPECT_EQ(info["scales"][1]["resolution"], nlohmann::json({2, 2, 2}));

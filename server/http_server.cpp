@@ -67,12 +67,15 @@ const char* reason_phrase(int status) {
     case 201: return "Created";
     case 202: return "Accepted";
     case 204: return "No Content";
+    case 206: return "Partial Content";
+    case 304: return "Not Modified";
     case 400: return "Bad Request";
     case 404: return "Not Found";
     case 405: return "Method Not Allowed";
     case 409: return "Conflict";
     case 413: return "Payload Too Large";
     case 415: return "Unsupported Media Type";
+    case 416: return "Range Not Satisfiable";
     case 422: return "Unprocessable Entity";
     case 429: return "Too Many Requests";
     case 500: return "Internal Server Error";
@@ -175,8 +178,20 @@ class Server {
   void send(const restinio::request_handle_t& req, const HttpRequest& hr, const HttpResponse& resp) {
     metrics_.observe(hr.route.empty() ? "unmatched" : hr.route, hr.method, resp.status,
                      std::chrono::duration<double>(Clock::now() - hr.arrival).count());
-    auto rb = req->create_response(
-        restinio::http_status_line_t{restinio::http_status_code_t{std::uint16_t(resp.status)}, reason_phrase(resp.status)});
+    const restinio::http_status_line_t status{restinio::http_status_code_t{std::uint16_t(resp.status)},
+                                              reason_phrase(resp.status)};
+    // HEAD: the same status and headers as GET, the Content-Length of the body GET would send, no body.
+    int64_t head_only = resp.content_length;
+    if (head_only < 0 && hr.method == "HEAD") head_only = int64_t(resp.body.size());
+    if (head_only >= 0) {
+      auto rb = req->create_response<restinio::user_controlled_output_t>(status);
+      if (!resp.content_type.empty()) rb.append_header(restinio::http_field::content_type, resp.content_type);
+      for (const auto& [k, v] : resp.headers) rb.append_header(k, v);
+      rb.set_content_length(std::size_t(head_only));
+      rb.done();
+      return;
+    }
+    auto rb = req->create_response(status);
     if (!resp.content_type.empty()) rb.append_header(restinio::http_field::content_type, resp.content_type);
     for (const auto& [k, v] : resp.headers) rb.append_header(k, v);
     rb.set_body(resp.body);
@@ -235,6 +250,9 @@ class Server {
       hr->path = std::string(req->header().path());
       hr->content_type = media_type(req->header().get_field_or(restinio::http_field::content_type, ""));
       hr->accept = lower(req->header().get_field_or(restinio::http_field::accept, ""));
+      hr->range = req->header().get_field_or(restinio::http_field::range, "");
+      hr->if_range = req->header().get_field_or(restinio::http_field::if_range, "");
+      hr->if_none_match = req->header().get_field_or(restinio::http_field::if_none_match, "");
       std::vector<std::string> allowed;
       const Route* route = match_route(hr->method, hr->path, hr->path_params, allowed);
       if (!route) {

@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include <atomic>
+#include <cstdint>
 #include <map>
 #include <memory>
 #include <string>
@@ -24,6 +25,7 @@ struct HttpRequest {
   std::vector<std::pair<std::string, std::string>> query;     // decoded, in order
   std::string content_type;                                   // lower-case media type, no parameters
   std::string accept;                                         // raw Accept header (may be empty)
+  std::string range, if_range, if_none_match;                 // raw headers (conditional_get.h); may be empty
   std::string body;
   // Multipart bodies, split by the adapter: (part name, bytes).
   std::vector<std::pair<std::string, std::string>> parts;
@@ -39,6 +41,9 @@ struct HttpResponse {
   std::string content_type = "application/json";
   std::vector<std::pair<std::string, std::string>> headers;
   std::string body;
+  // >= 0: send only the head, with this Content-Length (a 304 gives the length a 200 would
+  // have). The adapter answers every HEAD this way, with the length of the body it drops.
+  int64_t content_length = -1;
 
   static HttpResponse json(int status, const nlohmann::json& j);
   static HttpResponse error(const Status& s);  // status code from http_errors.h

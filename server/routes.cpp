@@ -1,5 +1,7 @@
 #include "routes.h"
 
+#include <string_view>
+
 namespace solidtex::server {
 
 const std::vector<Route>& route_table() {
@@ -46,6 +48,8 @@ const std::vector<Route>& route_table() {
       {"GET", "/v1/volumes/{id}/zarr2/{scale}/{c}/{cz}/{cy}/{cx}", E::kWorker, &Api::zarr2_chunk},
       {"GET", "/v1/volumes/{id}/precomputed/info", E::kWorker, &Api::precomputed_info},
       {"GET", "/v1/volumes/{id}/precomputed/{scale}/{chunk}", E::kWorker, &Api::precomputed_chunk},
+      {"GET", "/v1/volumes/{id}/precomputed-jpeg/info", E::kWorker, &Api::precomputed_jpeg_info},
+      {"GET", "/v1/volumes/{id}/precomputed-jpeg/{scale}/{chunk}", E::kWorker, &Api::precomputed_jpeg_chunk},
   };
   return routes;
 }
@@ -107,7 +111,10 @@ const Route* match_route(const std::string& method, const std::string& path, std
       hit = nullptr;
     }
     methods.push_back(r.method);
-    if (!hit && method == r.method) {
+    // Every GET route answers HEAD too (RFC 9110 9.3.2); the adapter drops the body.
+    const bool head_of_get = method == "HEAD" && std::string_view(r.method) == "GET";
+    if (std::string_view(r.method) == "GET") methods.push_back("HEAD");
+    if (!hit && (method == r.method || head_of_get)) {
       hit = &r;
       params = std::move(p);
     }

@@ -23,8 +23,9 @@ struct Route {
 
 const std::vector<Route>& route_table();
 
-// The route for (method, path), filling `params`; null when none. `allowed` receives the
-// methods of routes whose template matches the path (for 405 and the Allow header).
+// The route for (method, path), filling `params`; null when none. HEAD matches the GET route
+// (the adapter sends its head only). `allowed` receives the methods of routes whose template
+// matches the path, HEAD with every GET (for 405 and the Allow header).
 const Route* match_route(const std::string& method, const std::string& path, std::map<std::string, std::string>& params,
                          std::vector<std::string>& allowed);
 

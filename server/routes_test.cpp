@@ -53,7 +53,17 @@ TEST(Routes, MatchesTemplatesAndReportsAllowedMethods) {
 
   allowed.clear();
   EXPECT_EQ(match_route("PUT", "/v1/volumes", params, allowed), nullptr);
-  EXPECT_EQ(std::set<std::string>(allowed.begin(), allowed.end()), (std::set<std::string>{"GET", "POST"}));
+  EXPECT_EQ(std::set<std::string>(allowed.begin(), allowed.end()), (std::set<std::string>{"GET", "HEAD", "POST"}));
+
+  // HEAD is answered by the GET route; a path without GET has no HEAD.
+  allowed.clear();
+  r = match_route("HEAD", "/v1/volumes/vol_1/zarr/0/c/0/1/2/3", params, allowed);
+  ASSERT_NE(r, nullptr);
+  EXPECT_STREQ(r->method, "GET");
+  EXPECT_EQ(params.at("cx"), "3");
+  allowed.clear();
+  EXPECT_EQ(match_route("HEAD", "/v1/volumes/vol_1/cut", params, allowed), nullptr);
+  EXPECT_EQ(allowed, (std::vector<std::string>{"POST"}));
 
   // A literal path belongs to its own route only: not also to /v1/fields/{id}.
   allowed.clear();

@@ -2,8 +2,11 @@
 OME-Zarr 0.4 under /zarr2, opened by URL with zarr-python 3 over fsspec's HTTP store, and
 compared bit for bit with the region endpoint; the HTTP behaviour chunked-array clients rely
 on (never 404 for "not computed yet", 404 only outside the array, strong ETags stable across
-restarts, immutable caching, CORS)."""
+restarts, immutable caching, CORS, HEAD, Range, If-None-Match); the OME-Zarr reader (ome-zarr)
+over the same URL; Neuroglancer's jpeg precomputed chunks."""
 from __future__ import annotations
+
+import io
 
 import numpy as np
 import pytest
@@ -94,6 +97,104 @@ def test_precomputed_raw_chunks_are_the_zarr_chunks_uncompressed(volume):
     assert coarse == v3["1"][:, 32:64, 0:32, 0:32].tobytes()
     for bad in ("0/0-65_0-8_0-8", "0/0-64_0-64_0-64", "0/120-136_0-8_0-8", "0/0-8_0-8", "1/64-96_0-32_0-32", "3/0-8_0-8_0-8"):
         assert requests.get(f"{base}/{bad}", timeout=60).status_code == 404, bad
+
+
+def test_precomputed_jpeg_chunks_are_the_raw_voxels_up_to_jpeg_loss(volume):
+    from PIL import Image
+    srv, vid, _ = volume
+    base = f"{srv.url}/v1/volumes/{vid}"
+    info = requests.get(f"{base}/precomputed-jpeg/info", timeout=60).json()
+    raw_info = requests.get(f"{base}/precomputed/info", timeout=60).json()
+    assert [s["encoding"] for s in info["scales"]] == ["jpeg"] * 3
+    assert [{**s, "encoding": "raw"} for s in info["scales"]] == raw_info["scales"]
+    for name, (x0, x1, y0, y1, z0, z1) in (("0-64_64-128_8-16", (0, 64, 64, 128, 8, 16)),
+                                           ("96-128_0-32_32-64", (96, 128, 0, 32, 32, 64))):
+        r = requests.get(f"{base}/precomputed-jpeg/0/{name}", timeout=120)
+        assert r.status_code == 200 and r.headers["Content-Type"] == "image/jpeg"
+        raw = requests.get(f"{base}/precomputed/0/{name}", timeout=120)
+        assert r.headers["ETag"] != raw.headers["ETag"]
+        img = Image.open(io.BytesIO(r.content))
+        # Neuroglancer's layout: width x, height y*z (z slices stacked), RGB
+        assert img.mode == "RGB" and img.size == (x1 - x0, (y1 - y0) * (z1 - z0))
+        got = np.asarray(img).reshape(z1 - z0, y1 - y0, x1 - x0, 3).astype(int)
+        want = np.moveaxis(region_czyx(srv, vid, (z0, y0, x0), (z1, y1, x1)), 0, -1).astype(int)
+        err = np.abs(got - want)
+        assert err.mean() < 8 and np.percentile(err, 99) < 40, (err.mean(), np.percentile(err, 99))  # any misplacement: > 30
+        print(f"{name}: jpeg {len(r.content)} bytes, raw {len(raw.content)}, mean error {err.mean():.2f}")
+        assert len(r.content) * 2 < len(raw.content), (len(r.content), len(raw.content))
+    assert requests.get(f"{base}/precomputed-jpeg/0/0-65_0-8_0-8", timeout=60).status_code == 404
+
+
+def test_ome_zarr_reader_lists_the_multiscales(volume):
+    ome_io = pytest.importorskip("ome_zarr.io", reason="ome-zarr is not installed (tests/python/requirements.txt)")
+    from ome_zarr.reader import Multiscales, Reader
+    srv, vid, _ = volume
+    location = ome_io.parse_url(f"{srv.url}/v1/volumes/{vid}/zarr")
+    assert location is not None and location.version == "0.5"
+    nodes = list(Reader(location)())
+    image = nodes[0]
+    assert any(isinstance(spec, Multiscales) for spec in image.specs)
+    assert [a["name"] for a in image.metadata["axes"]] == ["c", "z", "y", "x"]
+    # one dataset per synthesis level (the suite's 3), each half the side of the one before
+    assert [tuple(d.shape) for d in image.data] == [(3, EXTENT >> s, EXTENT >> s, EXTENT >> s) for s in range(3)]
+    scales = [t[0]["scale"] for t in image.metadata["coordinateTransformations"]]
+    assert scales == [[1.0, 1.0, 1.0, 1.0], [1.0, 2.0, 2.0, 2.0], [1.0, 4.0, 4.0, 4.0]]
+    got = np.asarray(image.data[0][:, 10:30, 40:52, 100:128])
+    assert np.array_equal(got, region_czyx(srv, vid, (10, 40, 100), (30, 52, 128)))
+
+
+ARRAY_URLS = ("zarr/zarr.json", "zarr/0/zarr.json", "zarr/0/c/0/1/1/1", "zarr2/.zgroup", "zarr2/.zattrs",
+              "zarr2/1/.zarray", "zarr2/1/0/1/0/1", "precomputed/info", "precomputed/0/0-32_0-32_0-32",
+              "precomputed-jpeg/info", "precomputed-jpeg/2/0-32_0-32_0-8")
+
+
+@pytest.mark.parametrize("path", ARRAY_URLS)
+def test_head_range_and_if_none_match_on_every_array_endpoint(volume, path):
+    srv, vid, _ = volume
+    url = f"{srv.url}/v1/volumes/{vid}/{path}"
+    full = requests.get(url, timeout=120)
+    assert full.status_code == 200, full.text
+    body, n, etag = full.content, len(full.content), full.headers["ETag"]
+    assert full.headers["Accept-Ranges"] == "bytes"
+    exposed = {h.strip() for h in full.headers["Access-Control-Expose-Headers"].split(",")}
+    assert {"ETag", "Content-Length", "Content-Range", "Accept-Ranges"} <= exposed
+    head = requests.head(url, timeout=120)
+    assert head.status_code == 200 and head.content == b""
+    for h in ("ETag", "Content-Type", "Cache-Control", "Accept-Ranges", "Access-Control-Allow-Origin"):
+        assert head.headers[h] == full.headers[h], h
+    assert int(head.headers["Content-Length"]) == n
+    for spec, (a, b) in ((f"bytes=3-9", (3, 9)), ("bytes=-5", (n - 5, n - 1)), (f"bytes={n - 3}-", (n - 3, n - 1)),
+                         (f"bytes=0-{n + 100}", (0, n - 1))):
+        r = requests.get(url, headers={"Range": spec}, timeout=120)
+        assert r.status_code == 206, (spec, r.status_code)
+        assert r.content == body[a:b + 1], spec
+        assert r.headers["Content-Range"] == f"bytes {a}-{b}/{n}", spec
+        assert r.headers["ETag"] == etag
+    r = requests.get(url, headers={"Range": f"bytes={n}-"}, timeout=120)
+    assert r.status_code == 416 and r.headers["Content-Range"] == f"bytes */{n}"
+    assert r.headers["Access-Control-Allow-Origin"] == "*"
+    h416 = requests.head(url, headers={"Range": f"bytes={n}-"}, timeout=120)
+    assert h416.status_code == 416 and h416.content == b""
+    for ignored in ("bytes=0-1,4-5", "bytes=x-y", "bytes=9-3", "lines=0-1"):
+        r = requests.get(url, headers={"Range": ignored}, timeout=120)
+        assert r.status_code == 200 and r.content == body, ignored
+    # If-Range naming another representation: the whole body
+    r = requests.get(url, headers={"Range": "bytes=0-0", "If-Range": '"stale"'}, timeout=120)
+    assert r.status_code == 200 and r.content == body
+    for inm in (etag, f'"other", W/{etag}', "*"):
+        r = requests.get(url, headers={"If-None-Match": inm}, timeout=120)
+        assert r.status_code == 304 and r.content == b"", inm
+        assert r.headers["ETag"] == etag and r.headers["Access-Control-Allow-Origin"] == "*"
+    assert requests.get(url, headers={"If-None-Match": '"other"'}, timeout=120).status_code == 200
+
+
+def test_head_outside_the_array_is_404_without_a_body(volume):
+    srv, vid, _ = volume
+    r = requests.head(f"{srv.url}/v1/volumes/{vid}/zarr/0/c/0/9/0/0", timeout=60)
+    assert r.status_code == 404 and r.content == b"" and int(r.headers["Content-Length"]) > 0
+    assert r.headers["Access-Control-Allow-Origin"] == "*"
+    r = requests.get(f"{srv.url}/v1/volumes/{vid}/zarr/0/c/0/9/0/0", headers={"Range": "bytes=0-3"}, timeout=60)
+    assert r.status_code == 404  # errors are never ranged
 
 
 def test_zarr2_mirror_reads_the_same_voxels(volume):
