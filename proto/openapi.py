@@ -65,7 +65,8 @@ RANGED = ("HEAD answers the same status and headers without the body. `If-None-M
           "several ranges, other units and malformed headers are ignored (200, the whole body). Every 200 says `Accept-Ranges: bytes`.")
 STR = {"schema": {"type": "string"}}
 ARRAY_HEADERS = {**CORS, "ETag": STR, "Cache-Control": STR, "Accept-Ranges": STR}
-ZARR_META = {"description": "Metadata (JSON).", "headers": ARRAY_HEADERS,
+ZARR_META = {"description": "Metadata (JSON); a strong ETag from (volume spec, --array-extent, the document's path), so every document has its own, stable across restarts; Cache-Control: public, max-age=60.",
+             "headers": ARRAY_HEADERS,
              "content": {"application/json": {"schema": {"type": "object"}}}}
 ZARR_CHUNK_OUT = {"description": "zstd-compressed chunk bytes; a strong ETag from (volume spec, format, dataset, chunk), stable across restarts; Cache-Control: public, max-age=31536000, immutable.",
                   "headers": {**ARRAY_HEADERS, "X-Voxels-Synthesized": {"schema": {"type": "integer"}}},

@@ -1,10 +1,11 @@
 // Handlers of the chunked-array views (chunked_arrays.h): decode the path, ask the volume
 // service, encode. Every answer carries CORS headers (browser viewers read them cross-origin);
-// chunks carry a strong ETag from (volume spec, format, dataset, chunk) and are immutable.
+// metadata and chunks carry strong ETags (array_etag.h); chunks are immutable.
 // Successful answers go through conditional_get (If-None-Match, Range); HEAD is the adapter's.
 #include <charconv>
 
 #include "api.h"
+#include "array_etag.h"
 #include "chunked_arrays.h"
 #include "conditional_get.h"
 #include "core/image_io.h"
@@ -57,7 +58,7 @@ HttpResponse Api::array_metadata(const HttpRequest& r, const std::function<Resul
     SOLIDTEX_ASSIGN_OR_RETURN(const json j, make(view));
     HttpResponse out = HttpResponse::json(200, j);
     // The window follows --array-extent, so metadata may change across restarts: revalidate.
-    out.headers.push_back({"ETag", "\"" + view.tag + "-" + std::to_string(view.window.extent) + "-" + r.route + "\""});
+    out.headers.push_back({"ETag", metadata_etag(view.tag, view.window.extent, r.path)});
     out.headers.push_back({"Cache-Control", "public, max-age=60"});
     add_cors(out);
     return conditional_get(r, std::move(out));
@@ -150,7 +151,7 @@ HttpResponse Api::precomputed_chunk_as(const HttpRequest& r, const std::string& 
 // encoded them.
 Result<HttpResponse> Api::serve_box(const HttpRequest& r, const ArrayView& view, int scale, const ChunkBox& box,
                                     const std::string& format, const std::string& key, ChunkEncoding encoding) {
-  const std::string etag = "\"" + view.tag + "-" + format + "-" + std::to_string(scale) + "-" + key + "\"";
+  const std::string etag = chunk_etag(view.tag, format, scale, key);
   int64_t synthesized = 0;
   std::shared_ptr<const std::string> body = chunks_.find(etag);
   if (!body) {

@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "api_json.h"
+#include "array_etag.h"
 #include "field/field_file.h"
 #include "core/json_fields.h"
 #include "query_params.h"
@@ -666,11 +667,7 @@ Result<VolumeService::ArrayInfo> VolumeService::array_info(const std::string& id
   const auto& state = held.state;
   ArrayInfo out;
   out.levels = state->regions ? 1 : state->synths[0]->table().levels();
-  uint64_t h = 0xcbf29ce484222325ull;  // FNV-1a of the spec's canonical dump (sorted keys)
-  for (const char c : v->info["spec"].dump()) h = (h ^ uint8_t(c)) * 0x100000001b3ull;
-  char hex[17];
-  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
-  out.tag = hex;
+  out.tag = fnv1a_hex(v->info["spec"].dump());  // the spec's canonical dump (sorted keys)
   return out;
 }
 

@@ -188,6 +188,31 @@ def test_head_range_and_if_none_match_on_every_array_endpoint(volume, path):
     assert requests.get(url, headers={"If-None-Match": '"other"'}, timeout=120).status_code == 200
 
 
+METADATA_URLS = ("zarr/zarr.json", "zarr/0/zarr.json", "zarr/1/zarr.json", "zarr2/.zgroup", "zarr2/.zattrs",
+                 "zarr2/0/.zarray", "zarr2/1/.zarray", "precomputed/info", "precomputed-jpeg/info")
+
+
+def metadata_etags(url, vid):
+    return {p: requests.get(f"{url}/v1/volumes/{vid}/{p}", timeout=60).headers["ETag"] for p in METADATA_URLS}
+
+
+def test_every_metadata_document_has_its_own_etag(volume):
+    srv, vid, _ = volume
+    first = metadata_etags(srv.url, vid)
+    assert len(set(first.values())) == len(METADATA_URLS), first  # e.g. zarr/0 and zarr/1 differ
+    assert metadata_etags(srv.url, vid) == first
+    # a volume of the same spec: the same chunk ETags (content tag), but its own group documents
+    # (they name the volume), so its own metadata ETags
+    spec = srv.client.get_volume(vid)
+    twin = srv.client.create_volume(exemplar=spec["exemplars"][0], seed=spec["seed"])["id"]
+    assert twin != vid
+    chunk = "zarr/0/c/0/0/0/0"
+    assert (requests.head(f"{srv.url}/v1/volumes/{twin}/{chunk}", timeout=120).headers["ETag"]
+            == requests.head(f"{srv.url}/v1/volumes/{vid}/{chunk}", timeout=120).headers["ETag"])
+    others = metadata_etags(srv.url, twin)
+    assert not set(others.values()) & set(first.values()), others
+
+
 def test_head_outside_the_array_is_404_without_a_body(volume):
     srv, vid, _ = volume
     r = requests.head(f"{srv.url}/v1/volumes/{vid}/zarr/0/c/0/9/0/0", timeout=60)
@@ -233,12 +258,14 @@ def test_chunks_are_immutable_cors_and_404_only_outside_the_array(volume, binary
         assert r.headers.get("Access-Control-Allow-Origin") == "*", outside
     assert requests.get(f"{srv.url}/v1/volumes/vol_missing/zarr/zarr.json", timeout=60).status_code == 404
     assert requests.get(f"{base}/zarr/zarr.json", params={"x": 1}, timeout=60).status_code == 400
-    # the same chunk, the same bytes and ETag after a restart
+    metadata = metadata_etags(srv.url, vid)
+    # the same chunk, the same bytes and ETag after a restart; the same metadata ETags
     data_dir = srv.data_dir
     assert srv.stop(grace=10) == 0
     restarted = factory.start("--array-extent", EXTENT, data_dir=data_dir)
     r = requests.get(f"{restarted.url}/v1/volumes/{vid}/zarr/0/c/0/3/2/1", timeout=120)
     assert r.status_code == 200 and r.content == first.content and r.headers["ETag"] == etag
+    assert metadata_etags(restarted.url, vid) == metadata
 
 
 @pytest.mark.parametrize("flag,value", [("--array-extent", v) for v in ("33", "16", "0", str((1 << 20) + 32), "x")]
