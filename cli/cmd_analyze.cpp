@@ -3,16 +3,19 @@
 //   [--seed S] [--threads T] [--grain auto|none|x|y] -o TABLE.stx [--json]
 #include <nlohmann/json.hpp>
 
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
 
 #include "analysis/analysis.h"
+
 #include "args.h"
 #include "core/byte_io.h"
 #include "commands.h"
 #include "core/image_io.h"
 #include "progress_bar.h"
+#include "synthesis/usage_balance.h"
 #include "analysis/table_file.h"
 
 namespace solidtex::cli {
@@ -67,6 +70,10 @@ Status run_analyze(const std::vector<std::string>& argv) {
 
   ProgressBar bar;
   SOLIDTEX_ASSIGN_OR_RETURN(AnalysisResult result, analyze(exemplars, params, bar));
+  // Usage penalties are calibrated by synthesis, so they are a step after analysis proper.
+  const auto balance_start = std::chrono::steady_clock::now();
+  SOLIDTEX_ASSIGN_OR_RETURN(result.table, balance_usage(result.table, {}, bar));
+  const double balance_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - balance_start).count();
   const std::vector<uint8_t> bytes = encode_table(*result.table);
   SOLIDTEX_RETURN_IF_ERROR(write_file_atomic(out, bytes));
 
@@ -74,6 +81,7 @@ Status run_analyze(const std::vector<std::string>& argv) {
     nlohmann::json j;
     j["table"] = out;
     j["seconds"] = result.seconds;
+    j["balance_seconds"] = balance_seconds;
     j["table_bytes"] = bytes.size();
     j["shared_exemplar"] = exemplars.shared();
     j["grain"] = *layout;
@@ -92,7 +100,8 @@ Status run_analyze(const std::vector<std::string>& argv) {
                    {"search_k", params.search_k},     {"seed", params.seed}};
     std::cout << j.dump(2) << "\n";
   } else {
-    std::cout << "wrote " << out << " (" << bytes.size() << " bytes) in " << result.seconds << " s\n";
+    std::cout << "wrote " << out << " (" << bytes.size() << " bytes) in " << result.seconds << " s + "
+              << balance_seconds << " s usage balancing\n";
     for (const LevelReport& r : result.levels)
       std::cout << "  level " << r.level << " (h=" << r.spacing << "): crossbar error " << r.mean_crossbar_error
                 << " vs random " << r.random_crossbar_error << "\n";

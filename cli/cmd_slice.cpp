@@ -60,7 +60,7 @@ Result<TargetSet> parse_cut(const Args& args) {
 Status run_slice(const std::vector<std::string>& argv) {
   Args args({"-o", "--axis", "--at", "--origin", "--plane", "--size", "--scheme", "--field", "--seed", "--threads",
              "--stats", "--passes", "--coarse-passes", "--cell", "--cache-mb", "--plane-weights", "--matcher", "--region-table", "--regions",
-             "--typicality", "--init", "--color", "--finest-subpass-size"},
+             "--typicality", "--balance", "--init", "--color", "--finest-subpass-size"},
             {"--energy"});
   SOLIDTEX_RETURN_IF_ERROR(args.parse(argv));
   if (args.positionals().size() != 1)
@@ -94,6 +94,8 @@ Status run_slice(const std::vector<std::string>& argv) {
   }
   SOLIDTEX_ASSIGN_OR_RETURN(double typicality, args.get_double("--typicality", params.typicality, 0, 4));
   params.typicality = float(typicality);
+  SOLIDTEX_ASSIGN_OR_RETURN(double balance, args.get_double("--balance", params.balance, 0, 4));
+  params.balance = float(balance);
   SOLIDTEX_RETURN_IF_ERROR(params.validate());
   SOLIDTEX_ASSIGN_OR_RETURN(int threads, args.get_int("--threads", 0, 0, 1024));
   set_thread_limit(threads);

@@ -54,6 +54,7 @@ constexpr Param<SynthesisParams> kSynthesisParams[] = {
     {"trilinear_levels", &SynthesisParams::trilinear_levels, 0, 8},
     {"plane_weights", &SynthesisParams::plane_weights, 0, 1},
     {"typicality", &SynthesisParams::typicality, 0, 4},
+    {"balance", &SynthesisParams::balance, 0, 4},
 };
 
 template <typename... F>

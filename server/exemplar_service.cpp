@@ -8,6 +8,7 @@
 #include <mutex>
 #include <thread>
 
+#include "synthesis/usage_balance.h"
 #include "analysis/analysis.h"
 #include "api_json.h"
 #include "analysis/exemplar.h"
@@ -156,7 +157,14 @@ struct ExemplarService::Impl {
   class JobInterrupter : public Interrupter {
    public:
     JobInterrupter(Impl& impl, std::string id) : impl_(impl), id_(std::move(id)) {}
+    // The job's percent spans [from, to] while the next stage reports 0..100, so progress
+    // never runs backwards between analysis and usage balancing.
+    void stage(int from, int to) {
+      from_ = from;
+      to_ = to;
+    }
     bool was_interrupted(int percent) override {
+      if (percent >= 0) percent = from_ + percent * (to_ - from_) / 100;
       if (percent >= 0) {
         std::lock_guard<std::mutex> g(impl_.mutex);
         auto it = impl_.entries.find(id_);
@@ -170,6 +178,7 @@ struct ExemplarService::Impl {
    private:
     Impl& impl_;
     std::string id_;
+    int from_ = 0, to_ = 100;
   };
 
   int attempts(const std::string& id) const {
@@ -200,10 +209,14 @@ struct ExemplarService::Impl {
       AnalysisParams p = params;
       SOLIDTEX_ASSIGN_OR_RETURN(ExemplarSet set, build_set(parts, meta.value("grain", ""), meta.value("mask_weight", 1.0f), p));
       JobInterrupter interrupter(*this, id);
+      interrupter.stage(0, 75);
       SOLIDTEX_ASSIGN_OR_RETURN(AnalysisResult r, analyze(set, params, interrupter));
+      interrupter.stage(75, 100);
+      SOLIDTEX_ASSIGN_OR_RETURN(r.table, balance_usage(r.table, {}, interrupter));
       const std::vector<uint8_t> bytes = encode_table(*r.table);
       SOLIDTEX_RETURN_IF_ERROR(store.write(ResourceKind::kExemplar, id, "table.stx", bytes));
-      return json{{"levels", to_json(r.levels)}, {"table_bytes", int64_t(bytes.size())}, {"seconds", r.seconds}};
+      return json{{"levels", to_json(r.levels)}, {"table_bytes", int64_t(bytes.size())},
+                  {"seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()}};
     }();
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (!result && stopping.load()) {  // abandoned by a clean shutdown: runs again, uncounted

@@ -504,17 +504,18 @@ bool pin_params(json& spec, const json& values) {
 // The defaults a new volume pins (SynthesisParams), and the ones volumes stored before each
 // was pinned were synthesized with: typicality did not exist (0), fine levels ran two
 // correction passes, the coarsest level started from slabs, output colors were means, and the
-// finest level ran 8 subpasses per pass.
+// finest level ran 8 subpasses per pass, and usage penalties were not applied.
 json current_defaults() {
   const SynthesisParams d;
   return {{"typicality", d.typicality},
+          {"balance", d.balance},
           {"passes", d.passes},
           {"init", init_name(d.init)},
           {"color", color_rule_name(d.color)},
           {"finest_subpass_size", d.finest_subpass_size}};
 }
 json legacy_defaults() {
-  return {{"typicality", 0.0}, {"passes", 2}, {"init", "slab"}, {"color", "mean"}, {"finest_subpass_size", 2}};
+  return {{"typicality", 0.0}, {"passes", 2}, {"init", "slab"}, {"color", "mean"}, {"finest_subpass_size", 2}, {"balance", 0.0}};
 }
 
 }  // namespace

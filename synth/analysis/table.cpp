@@ -1,5 +1,7 @@
 #include "analysis/table.h"
 
+#include <cmath>
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -62,6 +64,41 @@ Result<std::shared_ptr<const Table>> Table::assemble(AnalysisParams params, Exem
     }
     table->levels_[l].candidates = std::move(candidates[l]);
   }
+  return std::shared_ptr<const Table>(std::move(table));
+}
+
+bool Table::has_usage() const { return !levels_.empty() && !levels_[0].planes[0]->usage.empty(); }
+
+UsagePenalties Table::usage() const {
+  if (!has_usage()) return {};
+  UsagePenalties out(levels_.size());
+  for (size_t l = 0; l < levels_.size(); ++l)
+    for (int k = 0; k < distinct_images(); ++k) out[l].push_back(levels_[l].planes[size_t(k)]->usage);
+  return out;
+}
+
+Result<std::shared_ptr<const Table>> Table::with_usage(UsagePenalties usage) const {
+  if (!usage.empty()) {
+    if (usage.size() != levels_.size()) return Status(StatusCode::kCorrupt, "usage penalties: level count does not match");
+    for (size_t l = 0; l < levels_.size(); ++l) {
+      if (int(usage[l].size()) != distinct_images())
+        return Status(StatusCode::kCorrupt, "usage penalties: image count does not match");
+      for (int k = 0; k < distinct_images(); ++k) {
+        const auto& u = usage[l][size_t(k)];
+        if (u.size() != size_t(levels_[l].planes[size_t(k)]->stack.pixel_count()))
+          return Status(StatusCode::kCorrupt, "usage penalties: pixel count does not match the exemplar");
+        for (float v : u)
+          if (!(std::isfinite(v) && v >= 0.f)) return Status(StatusCode::kCorrupt, "usage penalties must be finite and >= 0");
+      }
+    }
+  }
+  auto table = std::make_shared<Table>(*this);
+  for (size_t l = 0; l < levels_.size(); ++l)
+    for (int k = 0; k < distinct_images(); ++k) {
+      auto app = std::make_shared<PlaneAppearance>(*levels_[l].planes[size_t(k)]);
+      app->usage = usage.empty() ? std::vector<float>{} : std::move(usage[l][size_t(k)]);
+      for (int p = k; p < (distinct_images() == 1 ? 3 : k + 1); ++p) table->levels_[l].planes[size_t(p)] = app;
+    }
   return std::shared_ptr<const Table>(std::move(table));
 }
 

@@ -1,5 +1,6 @@
 #include "analysis/table_file.h"
 
+#include <cmath>
 #include <cstring>
 
 #include "core/byte_io.h"
@@ -89,10 +90,14 @@ std::vector<uint8_t> encode_table(const Table& table) {
         }
     }
   }
+  if (table.has_usage())
+    for (int l = 0; l < table.levels(); ++l)
+      for (int k = 0; k < distinct; ++k)
+        for (float v : table.level(PyramidLevel{l}).planes[k]->usage) w.f32(v);
   std::vector<uint8_t> payload = std::move(w.buffer());
   ByteWriter h;
   h.bytes(std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(kMagic), 8));
-  h.u32(kTableFormatVersion);
+  h.u32(table.has_usage() ? kTableFormatVersion : 2);
   h.u32(kHeaderBytes);
   h.u64(payload.size());
   h.u64(checksum64(payload));
@@ -111,10 +116,11 @@ Result<std::shared_ptr<const Table>> decode_table(std::span<const uint8_t> bytes
   SOLIDTEX_RETURN_IF_ERROR(hr.u32(header_bytes));
   SOLIDTEX_RETURN_IF_ERROR(hr.u64(payload_bytes));
   SOLIDTEX_RETURN_IF_ERROR(hr.u64(checksum));
-  if (version != kTableFormatVersion)
+  if (version < kOldestTableFormatVersion || version > kTableFormatVersion)
     return Status(StatusCode::kVersionMismatch,
-                  "table format version " + std::to_string(version) + " is not supported (this build reads version " +
-                      std::to_string(kTableFormatVersion) + "); re-run analyze",
+                  "table format version " + std::to_string(version) + " is not supported (this build reads versions " +
+                      std::to_string(kOldestTableFormatVersion) + " to " + std::to_string(kTableFormatVersion) +
+                      "); re-run analyze",
                   "table");
   if (header_bytes != kHeaderBytes) return corrupt("header size field is wrong");
   if (payload_bytes != bytes.size() - kHeaderBytes)
@@ -188,8 +194,22 @@ Result<std::shared_ptr<const Table>> decode_table(std::span<const uint8_t> bytes
       }
     }
   }
+  UsagePenalties usage;
+  if (version >= 3) {
+    usage.resize(size_t(p.levels));
+    for (int l = 0; l < p.levels; ++l)
+      for (int k = 0; k < distinct; ++k) {
+        std::vector<float>& u = usage[size_t(l)].emplace_back(size_t(images[k]->pixel_count()));
+        for (float& v : u) {
+          SOLIDTEX_RETURN_IF_ERROR(r.f32(v));
+          if (!(std::isfinite(v) && v >= 0.f)) return corrupt("usage penalty is negative or not finite");
+        }
+      }
+  }
   if (r.remaining() != 0) return corrupt("unexpected bytes after the last level");
-  return Table::assemble(p, std::move(exemplars), std::move(pcas), std::move(candidates));
+  SOLIDTEX_ASSIGN_OR_RETURN(auto table, Table::assemble(p, std::move(exemplars), std::move(pcas), std::move(candidates)));
+  if (usage.empty()) return table;
+  return table->with_usage(std::move(usage));
 }
 
 Status save_table(const std::string& path, const Table& table) {

@@ -49,6 +49,41 @@ TEST(TableFile, RoundTripIsExact) {
   }
 }
 
+// Usage penalties (version 3) come back bit for bit; a table without them is still written as
+// version 2, which older builds read.
+TEST(TableFile, UsagePenaltiesRoundTripAndTablesWithoutThemStayVersion2) {
+  for (bool mask : {false, true}) {
+    auto t = small_table(mask);
+    EXPECT_FALSE(t->has_usage());
+    EXPECT_EQ(encode_table(*t)[8], 2);
+    UsagePenalties usage(size_t(t->levels()));
+    for (int l = 0; l < t->levels(); ++l)
+      for (int k = 0; k < t->distinct_images(); ++k) {
+        auto& u = usage[size_t(l)].emplace_back(size_t(t->level(PyramidLevel{l}).planes[size_t(k)]->stack.pixel_count()));
+        for (size_t i = 0; i < u.size(); ++i) u[i] = 0.25f * float((i * 7 + size_t(l) + size_t(k)) % 13);
+      }
+    auto with = t->with_usage(usage);
+    ASSERT_TRUE(with.is_ok()) << with.status().to_string();
+    ASSERT_TRUE((*with)->has_usage());
+    auto bytes = encode_table(**with);
+    EXPECT_EQ(bytes[8], kTableFormatVersion);
+    auto back = decode_table(bytes);
+    ASSERT_TRUE(back.is_ok()) << back.status().to_string();
+    EXPECT_EQ((*back)->usage(), usage);
+    EXPECT_EQ(encode_table(**back), bytes);
+    // Planes sharing an image share its penalties.
+    const auto& level = (*back)->level(PyramidLevel{0});
+    EXPECT_EQ(level.planes[1]->usage, level.planes[mask ? 1 : 0]->usage);
+    // Wrong sizes and negative values are refused, naming what is wrong.
+    auto bad = usage;
+    bad[0][0].pop_back();
+    EXPECT_EQ(t->with_usage(bad).status().code(), StatusCode::kCorrupt);
+    bad = usage;
+    bad[0][0][3] = -1.f;
+    EXPECT_NE(t->with_usage(bad).status().message().find(">= 0"), std::string::npos);
+  }
+}
+
 TEST(TableFile, DamagedFilesFailCleanly) {
   auto bytes = encode_table(*small_table(false));
   // Truncations at many points, including inside the header.

@@ -174,6 +174,22 @@ CorrectionContext CorrectionContext::make(const Table& table, PyramidLevel l, co
   ctx.color_rule = params.color;
   ctx.typicality = params.typicality;
   ctx.level = &table.level(l);
+  for (int k = 0; k < 3; ++k) {
+    const PlaneAppearance& app = *ctx.level->planes[size_t(k)];
+    const bool usage = params.balance > 0.f && !app.usage.empty();
+    if (!(params.typicality > 0.f) && !usage) continue;
+    if (k > 0 && ctx.level->planes[size_t(k - 1)].get() == &app) {
+      ctx.penalty[size_t(k)] = ctx.penalty[size_t(k - 1)];
+      continue;
+    }
+    auto pen = std::make_shared<std::vector<float>>(app.typicality.size());
+    for (size_t i = 0; i < pen->size(); ++i) {
+      float v = params.typicality * app.typicality[i];
+      if (usage) v += params.balance * app.usage[i];
+      (*pen)[i] = v;
+    }
+    ctx.penalty[size_t(k)] = std::move(pen);
+  }
   ctx.n = table.params().neighborhood;
   ctx.spacing = table.spacing(l);
   ctx.channels = table.exemplars().channels();
@@ -209,11 +225,11 @@ struct PlaneTerm {
   const float* query;
   const PlaneAppearance* app;
   float weight;
-  float typicality;
+  const float* penalty;  // CorrectionContext::penalty, or null
   int dims;
   float operator()(size_t pixel) const {
     float dk = plane_distance(query, &app->projected[pixel * size_t(dims)], dims);
-    if (typicality > 0.f) dk += typicality * app->typicality[pixel];
+    if (penalty) dk += penalty[pixel];
     return weight * dk;
   }
   void prefetch(size_t pixel) const {
@@ -237,8 +253,8 @@ void project_planes(const CorrectionContext& ctx, CorrectionScratch& s) {
 
 // The winner is the minimum of (cost, triple) over the candidate set, so the order in which
 // candidates are visited cannot change it; only the cost of each survivor must be exact.
-// A candidate's cost is ((t0 + t1) + t2) in floats, t_k = w_k * (distance_k + typicality *
-// penalty_k) >= 0, and float addition of non-negative terms is monotone, so any partial sum
+// A candidate's cost is ((t0 + t1) + t2) in floats, t_k = w_k * (distance_k + penalty_k) >= 0
+// (CorrectionContext::penalty), and float addition of non-negative terms is monotone, so any partial sum
 // is a lower bound of the cost: a candidate (or a whole source list) whose lower bound
 // exceeds the best cost so far is skipped without changing the result. Every candidate of
 // plane k's source list at pixel p has T[k] = p, so t_k is computed once per source, and
@@ -249,7 +265,7 @@ CoordinateTriple best_candidate(const CorrectionContext& ctx, const CoordinateTr
   std::array<PlaneTerm, 3> term;
   for (int k = 0; k < 3; ++k)
     term[size_t(k)] = {s.projected.data() + size_t(k) * ctx.dims, level.planes[size_t(k)].get(), ctx.cost_weights[size_t(k)],
-                       ctx.typicality, ctx.dims};
+                       ctx.penalty[size_t(k)] ? ctx.penalty[size_t(k)]->data() : nullptr, ctx.dims};
   float best = std::numeric_limits<float>::infinity();
   CoordinateTriple best_t{};
   auto offer = [&](float cost, const CoordinateTriple& t) {

@@ -17,7 +17,8 @@
 // N x N x C vector is projected by that plane's PCA basis; a candidate's cost is the sum over
 // planes of squared distances to its stored appearance vectors, each plus `typicality` times
 // the candidate pixel's typicality penalty (analysis/typicality.h: a pull away from the
-// exemplar's mean appearance, against the L2 match's collapse into smooth blobs). Lowest cost
+// exemplar's mean appearance, against the L2 match's collapse into smooth blobs), plus `balance`
+// times its usage penalty where the table has one (synthesis/usage_balance.h). Lowest cost
 // wins; equal costs go to the lexicographically smallest triple. No randomness, fixed
 // summation order.
 //
@@ -30,6 +31,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "field/frame_field.h"
@@ -87,6 +89,10 @@ struct CorrectionContext {
   PlaneWeights color_weights{1.f / 3, 1.f / 3, 1.f / 3};
   ColorRule color_rule = ColorRule::kMedoid;         // output colors only (finest level)
   float typicality = 0.f;                            // SynthesisParams::typicality
+  // Per plane, every exemplar pixel's penalty added to its match cost: typicality times its
+  // typicality penalty plus balance times its usage penalty (float ops in that order); null
+  // when both weights are 0 or there is nothing to weigh. Shared by planes sharing an image.
+  std::array<std::shared_ptr<const std::vector<float>>, 3> penalty;
   static CorrectionContext make(const Table& table, PyramidLevel l, const SynthesisParams& params);
 };
 

@@ -86,6 +86,11 @@ struct SynthesisParams {
   // (Zhang et al.), whose slices collapse into smooth blobs; 0.5 keeps pebbles, veins and
   // weave crisp (bench/bench_quality.py); much above 1 favours extremes and noise.
   float typicality = 0.5f;
+  // Weight of the table's usage penalties in matching costs (synthesis/usage_balance.h), [0, 4]:
+  // 1 applies them as calibrated (exemplar regions the matching over-uses cost more, regions
+  // it neglects less: Kopf et al.'s histogram matching as a fixed function of the table);
+  // 0 ignores them. Tables analysed before usage balancing have none, so it changes nothing.
+  float balance = 1.f;
 
   Status validate() const;
 };

@@ -67,6 +67,23 @@ def test_typicality_at_its_documented_extremes(srv):
     alive(srv)
 
 
+def test_balance_at_its_documented_extremes(srv):
+    # [0, 4] both synthesize and differ (the exemplar's table has usage penalties); anything
+    # outside, or not a number, is a 400 naming the field
+    cuts = []
+    for value in (0, 4):
+        r = create_volume(srv, params={"balance": value})
+        assert r.status_code == 201, r.text
+        assert r.json()["params"]["balance"] == value
+        got = slice_of(srv, r.json()["id"])
+        assert got.status_code == 200, got.text
+        cuts.append(got.content)
+    assert cuts[0] != cuts[1]
+    for value in (-0.001, 4.001, 1e308, "1", None, [1]):
+        assert_error(create_volume(srv, params={"balance": value}), 400, "invalid_argument", "params.balance")
+    alive(srv)
+
+
 def test_passes_at_their_documented_extremes(srv):
     # [0, 8] both synthesize and are stored as given (the default, 1, is pinned when absent);
     # anything outside, or not an integer, is a 400 naming the field

@@ -1,0 +1,56 @@
+// Usage balancing: per-pixel usage penalties that make synthesis use the whole exemplar.
+//
+// Why (issue 12): matching concentrates on a few exemplar regions (a few bricks, bright pebble
+// highlights) and never picks others, so slices lose the exemplar's variety and structure.
+// Kopf et al. 2007 reweight every match by histograms of what the volume has used so far, which
+// makes a voxel depend on everything synthesized before it. Here the reweighting is calibrated
+// once, after analysis, and stored in the table (Table::with_usage): synthesis stays a pure
+// function of (table, field, parameters, seed, voxel). SynthesisParams::balance weighs it.
+//
+// Calibration, level by level from the coarsest, `rounds` times per level: synthesize the
+// level's final voxels in a `box`^3 block (identity field, default parameters, calibration
+// seed, a block position per round) with the penalties so far; count how often the block's
+// triples name each exemplar pixel (per distinct image, all planes), blur the counts (Gaussian,
+// `sigma` exemplar pixels, wrapping), and add  strength * spread * log((c + m/10) / (1.1 m))  to
+// each pixel's penalty (c its blurred count, m the mean count, spread the image's total
+// appearance variance at that level, the match cost's scale); then shift so the least is 0.
+// Over-used pixels cost more, neglected ones less.
+//
+// Cost: rounds * levels block syntheses (about a second for a 128^2 exemplar on 2 cores).
+// Deterministic: fixed seed, positions and summation order; the same bits on any thread count.
+#pragma once
+
+#include <memory>
+
+#include "analysis/table.h"
+#include "core/interrupter.h"
+#include "core/status.h"
+#include "synthesis/synthesis_params.h"
+
+namespace solidtex {
+
+struct UsageBalanceParams {
+  int rounds = 3;          // calibration rounds per level, [0, 8]; 0 gives no penalties
+  float strength = 0.05f;  // penalty per unit of log over-use, in appearance spreads, [0, 1]
+  float sigma = 3.f;       // blur of the usage counts, exemplar pixels, [0.5, 32]
+  int box = 24;            // calibration block side, voxels of the level, [8, 64]
+  Status validate() const;
+};
+
+// `table` with usage penalties calibrated as above (it must have none yet: calibration starts
+// from none). Interrupted: kCancelled, progress in percent of the block syntheses.
+Result<std::shared_ptr<const Table>> balance_usage(std::shared_ptr<const Table> table, const UsageBalanceParams& params = {},
+                                                   Interrupter& interrupter = null_interrupter());
+
+// The final triples of the `box`^3 block at `min` on `level` (identity field, `params`), in
+// no particular order: what calibration counts, and what tests and benchmarks measure.
+Result<std::vector<CoordinateTriple>> level_triples(std::shared_ptr<const Table> table, const SynthesisParams& params,
+                                                    PyramidLevel level, Voxel min, int box,
+                                                    Interrupter& interrupter = null_interrupter());
+
+// How unevenly the triples name exemplar pixels: the Kullback-Leibler divergence (nats) of the
+// `sigma`-blurred usage counts from uniform use, over the distinct images at `level`. 0 is
+// perfectly even. For tests and benchmarks.
+double usage_divergence(const Table& table, PyramidLevel level, const std::vector<CoordinateTriple>& triples, float sigma);
+
+}  // namespace solidtex
