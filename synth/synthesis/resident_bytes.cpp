@@ -65,6 +65,9 @@ int64_t synthesizer_state_bytes(const Synthesizer& s) {
     const CorrectionContext ctx = CorrectionContext::make(table, PyramidLevel{l}, params);
     bytes += int64_t(sizeof(CorrectionContext));
     for (const PcaProjection& p : ctx.projection) bytes += projection_bytes(p);
+    for (int k = 0; k < 3; ++k)  // penalty arrays, shared by planes sharing an image
+      if (ctx.penalty[size_t(k)] && (k == 0 || ctx.penalty[size_t(k)] != ctx.penalty[size_t(k - 1)]))
+        bytes += int64_t(sizeof(std::vector<float>)) + 2 * kBlockOverhead + vector_bytes(*ctx.penalty[size_t(k)]);
     const LevelSchedule& sch = s.schedule(PyramidLevel{l});
     // Steps with their windows' barriers, and the slot table (at most 8 classes x versions).
     int64_t barriers = 0;

@@ -88,6 +88,33 @@ double appearance_spread(const PlaneAppearance& app) {
   return total;
 }
 
+// Synthesizes the finest `box`^3 block at `min` and returns, per level, the final triples the
+// request left in its cache: the block itself at the finest level, and at every coarser level
+// the (larger, in voxels of that level relatively) region the block depends on.
+Result<std::vector<std::vector<CoordinateTriple>>> final_triples_by_level(const std::shared_ptr<const Table>& table,
+                                                                          const SynthesisParams& params, Voxel min,
+                                                                          int box, Interrupter& interrupter) {
+  auto field = std::make_shared<ConstantField>(Quat{});
+  SOLIDTEX_ASSIGN_OR_RETURN(auto synth, Synthesizer::create(table, field, params, kCalibrationCacheBytes));
+  SOLIDTEX_ASSIGN_OR_RETURN(TargetSet target, TargetSet::box(min, box, box, box));
+  SOLIDTEX_RETURN_IF_ERROR(synth->synthesize(target, interrupter).status());
+  const int levels = table->levels();
+  std::vector<std::vector<CoordinateTriple>> out(static_cast<size_t>(levels));
+  for (int l = 0; l < levels; ++l) {
+    const int shift = levels - 1 - l;  // a level-l voxel is the parent of finest voxels v >> shift
+    constexpr int kMargin = 24;        // beyond any dependency halo at a level
+    const Voxel lo{(min.x >> shift) - kMargin, (min.y >> shift) - kMargin, (min.z >> shift) - kMargin};
+    const int side = ((box - 1) >> shift) + 2 + 2 * kMargin;
+    SOLIDTEX_ASSIGN_OR_RETURN(TargetSet region, TargetSet::box(lo, side, side, side));
+    std::vector<CoordinateTriple> triples;
+    std::vector<uint8_t> found;
+    synth->cache().lookup(PyramidLevel{l}, region.voxels, triples, found);
+    for (size_t i = 0; i < triples.size(); ++i)
+      if (found[i]) out[size_t(l)].push_back(triples[i]);
+  }
+  return out;
+}
+
 }  // namespace
 
 Status UsageBalanceParams::validate() const {
@@ -108,31 +135,32 @@ Result<std::shared_ptr<const Table>> balance_usage(std::shared_ptr<const Table> 
   for (int l = 0; l < levels; ++l)
     for (int k = 0; k < distinct; ++k)
       usage[size_t(l)].emplace_back(size_t(table->level(PyramidLevel{l}).planes[size_t(k)]->stack.pixel_count()), 0.f);
-  const int total = levels * params.rounds;
   SynthesisParams calibration;  // the defaults
   calibration.seed = kCalibrationSeed;
-  for (int l = 0; l < levels; ++l) {
-    const PyramidLevel level{l};
-    std::vector<double> spread(static_cast<size_t>(distinct));
-    for (int k = 0; k < distinct; ++k) spread[size_t(k)] = appearance_spread(*table->level(level).planes[size_t(k)]);
-    for (int round = 0; round < params.rounds; ++round) {
-      SOLIDTEX_ASSIGN_OR_RETURN(auto current, table->with_usage(usage));
-      ShareInterrupter share(interrupter, l * params.rounds + round, total);
-      // Blocks far apart, and from the origin where users look first, for independent samples.
-      const int at = 4096 * (round + 1);
-      SOLIDTEX_ASSIGN_OR_RETURN(auto triples, level_triples(current, calibration, level, Voxel{at, -at / 2, at / 3},
-                                                            params.box, share));
-      const auto counts = blurred_counts(*table, level, triples, params.sigma);
+  for (int round = 0; round < params.rounds; ++round) {
+    SOLIDTEX_ASSIGN_OR_RETURN(auto current, table->with_usage(usage));
+    ShareInterrupter share(interrupter, round, params.rounds);
+    // Blocks far apart, and from the origin where users look first, for independent samples.
+    const int at = 4096 * (round + 1);
+    const Voxel min{at, -at / 2, at / 3};
+    SOLIDTEX_ASSIGN_OR_RETURN(auto by_level, final_triples_by_level(current, calibration, min, params.box, share));
+    for (int l = 0; l < levels; ++l) {
+      const PyramidLevel level{l};
+      // Coarser levels are smoother: their counts are blurred over more exemplar pixels.
+      const float sigma = params.sigma * std::sqrt(float(table->spacing(level)));
+      const auto counts = blurred_counts(*table, level, by_level[size_t(l)], sigma);
       for (int k = 0; k < distinct; ++k) {
         const std::vector<double>& c = counts[size_t(k)];
         double sum = 0;
         for (double v : c) sum += v;
         const double mean = sum / double(c.size());
+        if (!(mean > 0)) continue;
+        const double spread = appearance_spread(*table->level(level).planes[size_t(k)]);
         std::vector<float>& u = usage[size_t(l)][size_t(k)];
         std::vector<double> next(u.size());
         double least = 0;
         for (size_t p = 0; p < u.size(); ++p) {
-          next[p] = double(u[p]) + params.strength * spread[size_t(k)] * std::log((c[p] + 0.1 * mean) / (1.1 * mean));
+          next[p] = double(u[p]) + params.strength * spread * std::log((c[p] + 0.1 * mean) / (1.1 * mean));
           least = p == 0 ? next[p] : std::min(least, next[p]);
         }
         for (size_t p = 0; p < u.size(); ++p) u[p] = float(next[p] - least);

@@ -7,16 +7,17 @@
 // once, after analysis, and stored in the table (Table::with_usage): synthesis stays a pure
 // function of (table, field, parameters, seed, voxel). SynthesisParams::balance weighs it.
 //
-// Calibration, level by level from the coarsest, `rounds` times per level: synthesize the
-// level's final voxels in a `box`^3 block (identity field, default parameters, calibration
-// seed, a block position per round) with the penalties so far; count how often the block's
-// triples name each exemplar pixel (per distinct image, all planes), blur the counts (Gaussian,
-// `sigma` exemplar pixels, wrapping), and add  strength * spread * log((c + m/10) / (1.1 m))  to
-// each pixel's penalty (c its blurred count, m the mean count, spread the image's total
+// Calibration, `rounds` times: synthesize a finest `box`^3 block (identity field, default
+// parameters, calibration seed, a block position per round) with the penalties so far; at every
+// level count how often the final triples the block depends on name each exemplar pixel (per
+// distinct image, all planes), blur the counts (Gaussian, `sigma` * sqrt(spacing) exemplar
+// pixels, wrapping: coarse levels are smooth), and add  strength * spread * log((c + m/10) / (1.1 m))
+// to each pixel's penalty (c its blurred count, m the mean count, spread the image's total
 // appearance variance at that level, the match cost's scale); then shift so the least is 0.
-// Over-used pixels cost more, neglected ones less.
+// Over-used pixels cost more, neglected ones less; all levels are updated together, so a
+// round costs one block synthesis.
 //
-// Cost: rounds * levels block syntheses (about a second for a 128^2 exemplar on 2 cores).
+// Cost: `rounds` finest-block syntheses, whatever the exemplar's size (about 1-2 s each on 2 cores).
 // Deterministic: fixed seed, positions and summation order; the same bits on any thread count.
 #pragma once
 
@@ -31,9 +32,9 @@ namespace solidtex {
 
 struct UsageBalanceParams {
   int rounds = 3;          // calibration rounds per level, [0, 8]; 0 gives no penalties
-  float strength = 0.05f;  // penalty per unit of log over-use, in appearance spreads, [0, 1]
-  float sigma = 3.f;       // blur of the usage counts, exemplar pixels, [0.5, 32]
-  int box = 24;            // calibration block side, voxels of the level, [8, 64]
+  float strength = 0.025f; // penalty per unit of log over-use, in appearance spreads, [0, 1]
+  float sigma = 3.f;       // blur of the finest level's usage counts, exemplar pixels, [0.5, 32]
+  int box = 24;            // calibration block side, finest voxels, [8, 64]
   Status validate() const;
 };
 
