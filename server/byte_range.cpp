@@ -4,13 +4,14 @@
 #include <optional>
 
 namespace solidtex::server {
-namespace {
 
-std::string_view trim(std::string_view s) {
+std::string_view trim_ows(std::string_view s) {
   while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
   while (!s.empty() && (s.back() == ' ' || s.back() == '\t')) s.remove_suffix(1);
   return s;
 }
+namespace {
+
 
 // 1*DIGIT; an overflowing position is as unusable as a malformed one.
 std::optional<int64_t> digits(std::string_view s) {
@@ -33,8 +34,8 @@ bool unit_is_bytes(std::string_view unit) {
 ByteRange parse_byte_range(std::string_view header, int64_t total) {
   const ByteRange ignored;
   const size_t eq = header.find('=');
-  if (eq == std::string_view::npos || !unit_is_bytes(trim(header.substr(0, eq)))) return ignored;
-  const std::string_view spec = trim(header.substr(eq + 1));
+  if (eq == std::string_view::npos || !unit_is_bytes(trim_ows(header.substr(0, eq)))) return ignored;
+  const std::string_view spec = trim_ows(header.substr(eq + 1));
   if (spec.find(',') != std::string_view::npos) return ignored;  // several ranges: not served as multipart
   const size_t dash = spec.find('-');
   if (dash == std::string_view::npos) return ignored;

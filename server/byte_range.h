@@ -20,6 +20,9 @@ struct ByteRange {
   int64_t last = -1;
 };
 
+// `s` without the optional whitespace (spaces, tabs) HTTP allows around header values.
+std::string_view trim_ows(std::string_view s);
+
 ByteRange parse_byte_range(std::string_view header, int64_t total);
 
 }  // namespace solidtex::server

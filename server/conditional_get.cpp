@@ -8,11 +8,6 @@
 namespace solidtex::server {
 namespace {
 
-std::string_view trim(std::string_view s) {
-  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\t')) s.remove_suffix(1);
-  return s;
-}
 
 std::string_view opaque(std::string_view tag) {
   if (tag.size() >= 2 && tag.substr(0, 2) == "W/") tag.remove_prefix(2);
@@ -21,12 +16,12 @@ std::string_view opaque(std::string_view tag) {
 
 // If-None-Match: "*" or a comma-separated list of entity tags, compared weakly.
 bool none_match_fails(std::string_view header, std::string_view etag) {
-  header = trim(header);
+  header = trim_ows(header);
   if (header.empty()) return false;
   if (header == "*") return true;
   while (!header.empty()) {
     const size_t comma = header.find(',');
-    const std::string_view tag = trim(header.substr(0, comma));
+    const std::string_view tag = trim_ows(header.substr(0, comma));
     if (!tag.empty() && opaque(tag) == opaque(etag)) return true;
     if (comma == std::string_view::npos) break;
     header.remove_prefix(comma + 1);
@@ -55,7 +50,7 @@ HttpResponse conditional_get(const HttpRequest& r, HttpResponse full) {
   }
   if (r.range.empty()) return full;
   // If-Range: strong comparison, so a weak or different tag (or a date) means "send it all".
-  if (!r.if_range.empty() && (!etag || trim(r.if_range) != *etag || etag->starts_with("W/"))) return full;
+  if (!r.if_range.empty() && (!etag || trim_ows(r.if_range) != *etag || etag->starts_with("W/"))) return full;
   const ByteRange range = parse_byte_range(r.range, total);
   if (range.kind == ByteRange::kIgnored) return full;
   const std::string size = "/" + std::to_string(total);
