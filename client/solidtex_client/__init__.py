@@ -9,10 +9,14 @@
 >>> m = c.upload_mesh("bunny.off")
 >>> colored = c.surface(vol["id"], mesh_id=m["id"], placement={"resolution": 256})
 >>> from solidtex_client.render import render
->>> img = render(colored, azimuth=30, elevation=20, size=(512, 512))
+>>> img = render(colored, azimuth=30, elevation=20, size=(512, 512))   # per-vertex colors
+>>> view = c.render_pixels(vol["id"], mesh_id=m["id"], size=(512, 512))  # a color per pixel
+>>> baked = c.bake(vol["id"], mesh_id=m["id"], atlas_size=1024)          # needs xatlas
+>>> open("bunny.glb", "wb").write(baked.glb())
 """
 from .client import Client, encode_png, image_bytes
-from .mesh import ColoredMesh, PlyFormatError, mesh_bytes, parse_colored_ply
+from .mesh import (ColoredMesh, PlyFormatError, TriangleMesh, mesh_bytes, parse_colored_ply,
+                   parse_mesh_ply)
 from .errors import (BadRequest, Conflict, DeadlineExceeded, JobFailed, MethodNotAllowed,
                      NotFound, PayloadTooLarge, ServiceUnavailable, SolidtexError,
                      TooManyRequests, Unprocessable, UnsupportedMediaType,
@@ -20,7 +24,8 @@ from .errors import (BadRequest, Conflict, DeadlineExceeded, JobFailed, MethodNo
 
 __all__ = [
     "Client", "encode_png", "image_bytes",
-    "ColoredMesh", "PlyFormatError", "mesh_bytes", "parse_colored_ply",
+    "ColoredMesh", "PlyFormatError", "TriangleMesh", "mesh_bytes", "parse_colored_ply",
+    "parse_mesh_ply",
     "SolidtexError", "BadRequest", "NotFound", "MethodNotAllowed", "Conflict",
     "PayloadTooLarge", "UnsupportedMediaType", "Unprocessable", "TooManyRequests",
     "ServiceUnavailable", "DeadlineExceeded", "JobFailed", "error_from_response",

@@ -7,8 +7,13 @@
     solidtex-client region VOLUME --min X,Y,Z --size W,H,D -o OUT.vdb|OUT.npy
     solidtex-client points VOLUME POINTS.npy|POINTS.txt -o OUT.npy|OUT.txt
     solidtex-client mesh MESH.obj|.ply|.off [--name N]
-    solidtex-client render MESH --volume ID -o VIEW.png [--azimuth A --elevation E --size W,H
-                    --resolution R --margin M --no-light --up y|z --ply OUT.ply]
+    solidtex-client render MESH --volume ID -o VIEW.png [--colors pixel|vertex --azimuth A
+                    --elevation E --size W,H --resolution R --margin M --no-light --up y|z
+                    --ply OUT.ply (implies --colors vertex)]
+    solidtex-client bake MESH --volume ID -o OUT.glb [--atlas-size N | --texels-per-voxel T]
+                    [--resolution R --margin M --padding P --dilate D --texture OUT.png]
+
+MESH is a mesh file (OBJ, PLY or OFF) or the id of a stored mesh (mesh_...).
 
 JSON answers go to stdout. Errors print ``error: <code>: <message> (field)`` on stderr and
 exit with status 1. Coordinates and sizes are finest voxels, timeouts seconds.
@@ -118,9 +123,13 @@ def _parser() -> argparse.ArgumentParser:
     me.add_argument("--name")
 
     rd = sub.add_parser("render", help="texture a mesh with a volume and render it to a PNG")
-    rd.add_argument("mesh", help="OBJ, PLY or OFF file (sent as is)")
+    rd.add_argument("mesh", help="OBJ, PLY or OFF file, or a stored mesh's id")
     rd.add_argument("--volume", required=True)
     rd.add_argument("-o", "--output", required=True, help="PNG file")
+    rd.add_argument("--colors", choices=["pixel", "vertex"],
+                    help="pixel (default): each pixel's color from the volume at its surface "
+                         "point, one points batch; vertex (the default with --ply): the "
+                         "surface endpoint's vertex colors, interpolated")
     rd.add_argument("--azimuth", type=float, default=30.0, help="degrees (default 30)")
     rd.add_argument("--elevation", type=float, default=20.0, help="degrees (default 20)")
     rd.add_argument("--size", type=_ints(2), default=[512, 512], metavar="W,H",
@@ -131,9 +140,46 @@ def _parser() -> argparse.ArgumentParser:
                     help="fraction of the longest side added on every side (server default 0.25)")
     rd.add_argument("--no-light", action="store_true", help="unshaded vertex colors")
     rd.add_argument("--up", choices=["y", "z"], default="y", help="the mesh's up axis (default y)")
-    rd.add_argument("--ply", help="also write the colored mesh to this PLY file")
+    rd.add_argument("--ply", help="also write the vertex-colored mesh to this PLY file "
+                    "(implies --colors vertex)")
     rd.add_argument("--timeout", type=float, help="server deadline, seconds")
+
+    bk = sub.add_parser("bake", help="bake a volume's colors into a UV atlas: textured glTF "
+                        "(.glb)")
+    bk.add_argument("mesh", help="OBJ, PLY or OFF file, or a stored mesh's id")
+    bk.add_argument("--volume", required=True)
+    bk.add_argument("-o", "--output", required=True, help=".glb file")
+    density = bk.add_mutually_exclusive_group()
+    density.add_argument("--atlas-size", type=int,
+                         help="texels per side of the square texture (default 1024); the "
+                              "density is the highest that fits")
+    density.add_argument("--texels-per-voxel", type=float,
+                         help="texel density along the surface, texels per finest voxel; the "
+                              "atlas is as large as that needs")
+    bk.add_argument("--resolution", type=int,
+                    help="voxels along the mesh's longest side (default 512)")
+    bk.add_argument("--margin", type=float,
+                    help="fraction of the longest side added on every side (default 0.25)")
+    bk.add_argument("--padding", type=int, default=4, help="texels between charts (default 4)")
+    bk.add_argument("--dilate", type=int, default=8,
+                    help="rings of texels filled past chart borders (default 8)")
+    bk.add_argument("--texture", help="also write the texture to this PNG file")
+    bk.add_argument("--timeout", type=float, help="server deadline, seconds")
     return p
+
+
+def _mesh_arg(text: str) -> dict:
+    """``{"mesh": path}`` for an existing file, ``{"mesh_id": id}`` for a stored mesh's id."""
+    if os.path.exists(text):
+        return {"mesh": text}
+    if text.startswith("mesh_"):
+        return {"mesh_id": text}
+    raise FileNotFoundError(f"no mesh file {text!r} (and not a stored mesh's id, mesh_...)")
+
+
+def _placement(args: argparse.Namespace) -> dict:
+    return {k: v for k, v in (("resolution", args.resolution), ("margin", args.margin))
+            if v is not None}
 
 
 def _load_points(path: str) -> np.ndarray:
@@ -196,7 +242,41 @@ def _run(args: argparse.Namespace) -> None:
     elif args.command == "mesh":
         _print_json(client.upload_mesh(args.mesh, name=args.name))
     elif args.command == "render":
-        _render(client, args)
+        if (args.colors or ("vertex" if args.ply else "pixel")) == "pixel":
+            _render_pixels(client, args)
+        else:
+            _render(client, args)
+    elif args.command == "bake":
+        _bake(client, args)
+
+
+def _render_pixels(client: Client, args: argparse.Namespace) -> None:
+    from PIL import Image
+
+    if args.size[0] < 1 or args.size[1] < 1:
+        raise ValueError(f"--size must be positive, got {args.size}")
+    if args.ply:
+        raise ValueError("--ply writes vertex colors: it needs --colors vertex")
+    out = client.render_pixels(args.volume, **_mesh_arg(args.mesh), placement=_placement(args),
+                               azimuth=args.azimuth, elevation=args.elevation, size=args.size,
+                               light=not args.no_light, up=args.up, timeout=args.timeout)
+    Image.fromarray(out.image, "RGB").save(args.output, format="PNG")
+    _print_json({"output": args.output, "colors": "pixel", "triangles": len(out.mesh.faces),
+                 "placement": out.placement.to_json(), **out.stats})
+
+
+def _bake(client: Client, args: argparse.Namespace) -> None:
+    out = client.bake(args.volume, **_mesh_arg(args.mesh), placement=_placement(args),
+                      atlas_size=args.atlas_size, texels_per_voxel=args.texels_per_voxel,
+                      padding=args.padding, dilate_texels=args.dilate, timeout=args.timeout)
+    glb = out.glb()
+    with open(args.output, "wb") as f:
+        f.write(glb)
+    if args.texture:
+        with open(args.texture, "wb") as f:
+            f.write(out.png())
+    _print_json({"output": args.output, "bytes": len(glb), "placement": out.placement.to_json(),
+                 **out.stats})
 
 
 def _render(client: Client, args: argparse.Namespace) -> None:
@@ -206,9 +286,8 @@ def _render(client: Client, args: argparse.Namespace) -> None:
 
     if args.size[0] < 1 or args.size[1] < 1:
         raise ValueError(f"--size must be positive, got {args.size}")
-    placement = {k: v for k, v in (("resolution", args.resolution), ("margin", args.margin))
-                 if v is not None}
-    colored = client.surface(args.volume, mesh=args.mesh, placement=placement, fmt="ply",
+    where = _mesh_arg(args.mesh)
+    colored = client.surface(args.volume, **where, placement=_placement(args), fmt="ply",
                              timeout=args.timeout)
     if args.ply:
         with open(args.ply, "wb") as f:
@@ -216,7 +295,7 @@ def _render(client: Client, args: argparse.Namespace) -> None:
     img = render(colored, azimuth=args.azimuth, elevation=args.elevation, size=args.size,
                  light=not args.no_light, up=args.up)
     Image.fromarray(img, "RGB").save(args.output, format="PNG")
-    summary = {"output": args.output, "vertices": len(colored.vertices),
+    summary = {"output": args.output, "colors": "vertex", "vertices": len(colored.vertices),
                "triangles": len(colored.faces)}
     for key, header in (("target_voxels", "X-Target-Voxels"),
                         ("bounding_voxels", "X-Bounding-Voxels"),
@@ -239,7 +318,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     except requests.RequestException as e:
         print(f"error: connection: {e}", file=sys.stderr)
         return 1
-    except (OSError, ValueError, TimeoutError) as e:
+    except (OSError, ValueError, TimeoutError, ImportError, RuntimeError) as e:
         print(f"error: {type(e).__name__}: {e}", file=sys.stderr)
         return 1
     return 0

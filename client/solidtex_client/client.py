@@ -499,6 +499,29 @@ class Client:
                 answer[key] = _rows(answer[key], 3, np.float32)
         return answer
 
+    def render_pixels(self, volume_id: str, mesh_id: Optional[str] = None,
+                      mesh: Optional[MeshInput] = None, **options: Any) -> Any:
+        """Render a mesh with one colour per pixel from the volume (one ``points`` batch for
+        the surface points under the pixels; only their voxels are synthesized). Give a stored
+        mesh's ``mesh_id`` or a ``mesh`` file (uploaded for the call, then deleted).
+        ``options``: ``placement``, ``azimuth``, ``elevation``, ``size``, ``light``, ``up``,
+        ``border``, ``timeout``. Returns a
+        :class:`~solidtex_client.pixel_render.PixelRender` (see
+        :func:`~solidtex_client.pixel_render.render_pixels`)."""
+        from .pixel_render import render_pixels
+        return render_pixels(self, volume_id, mesh_id=mesh_id, mesh=mesh, **options)
+
+    def bake(self, volume_id: str, mesh_id: Optional[str] = None,
+             mesh: Optional[MeshInput] = None, **options: Any) -> Any:
+        """Bake the volume's colours on a mesh into a UV-atlas texture (needs ``xatlas``).
+        Give a stored mesh's ``mesh_id`` or a ``mesh`` file (uploaded for the call, then
+        deleted). ``options``: ``placement``, ``atlas_size`` or ``texels_per_voxel``,
+        ``padding``, ``dilate_texels``, ``timeout``. Returns a
+        :class:`~solidtex_client.bake.Bake`; ``.glb()`` gives the textured glTF bytes (see
+        :func:`~solidtex_client.bake.bake`)."""
+        from .bake import bake
+        return bake(self, volume_id, mesh_id=mesh_id, mesh=mesh, **options)
+
     # -- volumes --------------------------------------------------------------------------
 
     def list_volumes(self) -> List[Dict[str, Any]]:

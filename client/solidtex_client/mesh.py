@@ -8,13 +8,14 @@ The PLY answer is binary little-endian 1.0 with exactly::
 
 :func:`parse_colored_ply` reads that layout (comments allowed) and raises
 :class:`PlyFormatError` (a ``ValueError``) for anything else; :meth:`ColoredMesh.to_ply`
-writes it.
+writes it. A stored mesh's file (``GET /v1/meshes/{id}/file``) has the same layout without the
+colour properties: :func:`parse_mesh_ply` reads it as a :class:`TriangleMesh`.
 """
 from __future__ import annotations
 
 import os
 from dataclasses import dataclass, field
-from typing import Any, Dict, List, Tuple, Union
+from typing import Any, Dict, List, Optional, Tuple, Union
 
 import numpy as np
 
@@ -25,6 +26,8 @@ _UCHAR = {"uchar", "uint8"}
 _INT = {"int", "int32"}
 _VERTEX_PROPS = {"x": _FLOAT, "y": _FLOAT, "z": _FLOAT,
                  "red": _UCHAR, "green": _UCHAR, "blue": _UCHAR}
+_POSITION_PROPS = {"x", "y", "z"}
+_COLOR_PROPS = {"red", "green", "blue"}
 _FACE_DTYPE = np.dtype([("n", "u1"), ("i", "<i4", (3,))])  # packed: 13 bytes per face
 
 
@@ -95,6 +98,21 @@ class ColoredMesh:
         return head.encode("ascii") + v.tobytes() + f.tobytes()
 
 
+@dataclass
+class TriangleMesh:
+    """A triangle mesh: ``vertices`` float32 (N, 3) in mesh coordinates, ``faces`` int32
+    (M, 3) vertex indices."""
+
+    vertices: np.ndarray
+    faces: np.ndarray
+
+    def __post_init__(self) -> None:
+        self.vertices = np.ascontiguousarray(np.asarray(self.vertices, dtype=np.float32).reshape(-1, 3))
+        self.faces = np.ascontiguousarray(np.asarray(self.faces, dtype=np.int32).reshape(-1, 3))
+        if self.faces.size and (self.faces.min() < 0 or self.faces.max() >= len(self.vertices)):
+            raise ValueError("face index out of range")
+
+
 def _header(data: bytes) -> Tuple[List[List[str]], int]:
     if not data.startswith(b"ply"):
         raise PlyFormatError("not a PLY file (no 'ply' magic)")
@@ -118,6 +136,20 @@ def parse_colored_ply(data: Union[bytes, bytearray, memoryview]) -> ColoredMesh:
     Raises :class:`PlyFormatError` for another format (ASCII, big-endian), other or missing
     properties, non-triangle faces, out-of-range indices, or a body of the wrong length.
     """
+    vertices, colors, faces = _parse_ply(data, colors=True)
+    return ColoredMesh(vertices, colors, faces)
+
+
+def parse_mesh_ply(data: Union[bytes, bytearray, memoryview]) -> TriangleMesh:
+    """A :class:`TriangleMesh` from a stored mesh's file (the module doc's layout without
+    colours; colours, when present, are read and dropped). Errors as for
+    :func:`parse_colored_ply`."""
+    vertices, _, faces = _parse_ply(data, colors=False)
+    return TriangleMesh(vertices, faces)
+
+
+def _parse_ply(data: Union[bytes, bytearray, memoryview], colors: bool
+               ) -> Tuple[np.ndarray, Optional[np.ndarray], np.ndarray]:
     data = bytes(data)
     lines, body_at = _header(data)
     if lines[0] != ["ply"]:
@@ -162,7 +194,8 @@ def parse_colored_ply(data: Union[bytes, bytearray, memoryview]) -> ColoredMesh:
             raise PlyFormatError(f"vertex property {name} given twice")
         seen.add(name)
         fields.append((name, "<f4" if typ in _FLOAT else "u1"))
-    missing = [k for k in _VERTEX_PROPS if k not in seen]
+    required = _VERTEX_PROPS if colors or seen & _COLOR_PROPS else _POSITION_PROPS
+    missing = [k for k in required if k not in seen]
     if missing:
         raise PlyFormatError(f"vertex properties missing: {', '.join(missing)}")
     if len(face["props"]) != 1:
@@ -189,5 +222,7 @@ def parse_colored_ply(data: Union[bytes, bytearray, memoryview]) -> ColoredMesh:
         raise PlyFormatError(f"face {bad} has a vertex index out of range [0, {n}): "
                              f"{faces[bad].tolist()}")
     vertices = np.stack([v["x"], v["y"], v["z"]], axis=1).astype(np.float32)
-    colors = np.stack([v["red"], v["green"], v["blue"]], axis=1).astype(np.uint8)
-    return ColoredMesh(vertices, colors, faces)
+    rgb = None
+    if seen & _COLOR_PROPS:
+        rgb = np.stack([v["red"], v["green"], v["blue"]], axis=1).astype(np.uint8)
+    return vertices, rgb, faces
