@@ -2,10 +2,11 @@
 //   [--queue N] [--deadline S] [--max-deadline S] [--cache-mb M] [--max-upload-mb M]
 //   [--max-image-side PX] [--max-image-pixels N] [--max-voxels N] [--max-field-nodes N]
 //   [--max-jobs N] [--analysis-threads N] [--max-mesh-vertices N] [--max-mesh-faces N] [--max-request-mb M]
-//   [--volume-state-mb M] [--idle-evict-s S] [--array-extent VOXELS] [--chunk-cache-mb M]
+//   [--volume-state-mb M] [--idle-evict-s S] [--array-extent VOXELS] [--chunk-cache-mb M] [--web-root DIR]
 #include "args.h"
 #include "commands.h"
 #include "http_server.h"
+#include "static_files.h"
 
 namespace solidtex::cli {
 
@@ -13,7 +14,8 @@ Status run_serve(const std::vector<std::string>& argv) {
   Args args({"--host", "--port", "--data", "--threads", "--io-threads", "--queue", "--deadline", "--max-deadline",
              "--cache-mb", "--max-upload-mb", "--max-image-side", "--max-image-pixels", "--max-voxels",
              "--max-field-nodes", "--max-jobs", "--analysis-threads", "--max-mesh-vertices", "--max-mesh-faces",
-             "--max-request-mb", "--volume-state-mb", "--idle-evict-s", "--array-extent", "--chunk-cache-mb"},
+             "--max-request-mb", "--volume-state-mb", "--idle-evict-s", "--array-extent", "--chunk-cache-mb",
+             "--web-root"},
             {});
   SOLIDTEX_RETURN_IF_ERROR(args.parse(argv));
   if (!args.positionals().empty())
@@ -40,6 +42,10 @@ Status run_serve(const std::vector<std::string>& argv) {
   SOLIDTEX_ASSIGN_OR_RETURN(c.array_extent, args.get_int("--array-extent", int(c.array_extent), 32, 1 << 20));
   SOLIDTEX_ASSIGN_OR_RETURN(int chunk_mb, args.get_int("--chunk-cache-mb", int(c.chunk_cache_bytes >> 20), 0, 65536));
   c.chunk_cache_bytes = int64_t(chunk_mb) << 20;
+  // The browser app: the source tree's web/ unless named (validate() checks it holds index.html).
+  c.web_root = args.get("--web-root").value_or(server::default_web_root());
+  if (args.get("--web-root") && c.web_root.empty())
+    return Status(StatusCode::kInvalidArgument, "must name a directory", "--web-root");
   SOLIDTEX_ASSIGN_OR_RETURN(int request_mb, args.get_int("--max-request-mb", int(c.max_request_bytes >> 20), 16, 1 << 20));
   c.max_request_bytes = int64_t(request_mb) << 20;
   SOLIDTEX_ASSIGN_OR_RETURN(int state_mb, args.get_int("--volume-state-mb", int(c.volume_state_bytes >> 20), 0, 1 << 20));

@@ -106,6 +106,7 @@ MESH_OPS = ["get_mesh", "get_mesh_file", "delete_mesh"]
 image_out = {"description": "The cut. PNG (8-bit sRGB) by default; with `Accept: application/octet-stream` raw sRGB8 bytes (H x W x 3, row-major) and with `Accept: application/octet-stream; dtype=float32` raw little-endian float32 linear RGB; raw answers carry `X-Shape: H,W,3` and `X-Dtype`.",
     "headers": {"X-Shape": {"schema": {"type": "string"}}, "X-Dtype": {"schema": {"type": "string"}}, "X-Voxels-Synthesized": {"schema": {"type": "integer"}, "description": "Voxels this request synthesized over all levels (0 when everything was cached)."}},
     "content": {"image/png": {"schema": {"type": "string", "format": "binary"}}, "application/octet-stream": {"schema": {"type": "string", "format": "binary"}}}}
+scale_param = qp("scale", "Dataset s of the volume's pyramid, as /zarr's: 0 (default) the finest voxels; s > 0 synthesis level L-1-s, whose voxels are 2^s finest voxels wide (voxel i covers finest voxels [i*2^s, (i+1)*2^s)) and are that level's own colours, not filters of finer ones; nothing finer is synthesized, so coarse cuts are fast previews. Coordinates and sizes are then in that dataset's voxels. Past the volume's coarsest dataset (L-1; region volumes have dataset 0 only): 404.", integer(0, 7, default=0))
 analysis_params = [
     qp("name", "Free-form label, at most 200 characters.", {"type": "string", "maxLength": 200}),
     qp("levels", "Pyramid levels L.", integer(1, 8, default=4)),
@@ -160,7 +161,7 @@ S = {
      "error": nullable_error}},
  "ExemplarCreated": {"type": "object", "required": ["exemplar", "job"], "properties": {"exemplar": ref("Exemplar"), "job": ref("Job")}},
  "Field": {"type": "object", "required": ["id", "revision"], "properties": {
-     "id": {"type": "string"}, "revision": {"type": "integer", "description": "1 at creation, +1 per added curve."},
+     "id": {"type": "string"}, "revision": {"type": "integer", "description": "1 at creation, +1 per added or removed curve."},
      "curves": {"type": "integer"}, "dims": {"type": "array", "items": {"type": "integer"}}, "origin": {"type": "array", "items": {"type": "number"}},
      "spacing": {"type": "number"}, "singular_nodes": {"type": "integer"}, "residual": {"type": "number"}, "seconds": {"type": "number"}, "has_scales": {"type": "boolean"},
      "from_mesh": {"type": "object", "description": "Only in the answer of POST /v1/fields/from-mesh: kind, frames and curves used, dropped_curves (crest chains that define no frame), placement {scale, translate}."}},
@@ -230,7 +231,19 @@ S = {
 
 MESH_EXAMPLE = "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n"
 exemplar_links = {**links_to(EXEMPLAR_OPS, "/exemplar/id"), "get_job": link("get_job", "/job/id")}
+WEB_DESCRIPTION = ("Read from the web root at every request (server/static_files.h). A strong ETag made of the bytes and `Cache-Control: no-cache`, so that browsers revalidate: "
+                   "`If-None-Match` naming the ETag gets 304. HEAD and a single byte range as on the array views (206, 416).")
+WEB_HEADERS = {"ETag": STR, "Cache-Control": STR, "Accept-Ranges": STR}
+WEB_CONDITIONAL = {"206": {"description": "Partial content (a single `Range: bytes=...`).", "headers": {"ETag": STR, "Content-Range": STR}},
+                   "304": {"description": "Not modified: If-None-Match named the ETag; no body.", "headers": {"ETag": STR, "Cache-Control": STR}},
+                   "416": {**err("Range not satisfiable."), "headers": {"Content-Range": STR}}}
 paths = {
+ "/": {"get": {"operationId": "web_app", "summary": "The browser app (index.html of --web-root, by default the source tree's web/): upload exemplars, create volumes, browse and sketch cuts, orbit textured meshes. It loads its other files from /web/{file}. 404 when the server has no web root.",
+     "description": WEB_DESCRIPTION, "responses": {"200": {"description": "The page.", "headers": WEB_HEADERS, "content": {"text/html": {"schema": {"type": "string"}}}}, **WEB_CONDITIONAL, **errs("400", "404")}}},
+ "/web/{file}": {"parameters": [{"name": "file", "in": "path", "required": True, "description": "A file directly in the web root: 1 to 128 characters of [A-Za-z0-9_.-], not starting with '.' (any other name, a directory or a symbolic link: 404).", "schema": {"type": "string", "minLength": 1}}],
+   "get": {"operationId": "web_file", "summary": "A file of the browser app; its Content-Type follows the extension (text/javascript for its ES modules).", "description": WEB_DESCRIPTION,
+     "responses": {"200": {"description": "The file.", "headers": WEB_HEADERS, "content": {t: {"schema": {"type": "string", "format": "binary"}} for t in ("text/html", "text/javascript", "text/css", "application/json", "image/svg+xml", "image/png", "text/plain", "application/octet-stream")}},
+                   **WEB_CONDITIONAL, **errs("400", "404", "422")}}},
  "/healthz": {"get": {"operationId": "healthz", "summary": "Liveness.", "responses": {"200": js({"type": "object", "required": ["status"], "properties": {"status": {"type": "string", "enum": ["ok", "stopping"]}, "queue_depth": {"type": "integer"}, "workers_busy": {"type": "integer"}}}), **errs("400")}}},
  "/metrics": {"get": {"operationId": "metrics", "summary": "Prometheus text: requests and latency histograms per route, voxels synthesized, cache bytes and budget, queue depth, loaded volumes' state bytes and budget (solidtex_volume_state_bytes, solidtex_volume_state_budget_bytes, solidtex_volumes_loaded) and evictions by reason.", "responses": {"200": {"description": "OK", "content": {"text/plain": {"schema": {"type": "string"}}}}}}},
  "/v1/openapi.json": {"get": {"operationId": "openapi", "summary": "This document.", "responses": {"200": js({"type": "object"})}}},
@@ -262,7 +275,11 @@ paths = {
  "/v1/fields/{id}/curves": {"parameters": [pid()],
    "post": {"operationId": "add_curve", "summary": "Add one curve (a sketch curve object, schema SketchCurve) and re-solve incrementally; the revision increases. The curve must lie inside the field's domain (400).", "parameters": [timeout],
      "requestBody": {"required": True, "content": {"application/json": {"schema": ref("SketchCurve")}}},
-     "responses": {"200": js(ref("Field")), **errs("400", "404", "413", "415", "422", "503", "504")}}},
+     "responses": {"200": {**js(ref("Field")), "links": {"remove_last_curve": link("remove_last_curve", "/id", "Undo: remove the curve just added.")}},
+                   **errs("400", "404", "413", "415", "422", "503", "504")}}},
+ "/v1/fields/{id}/curves/last": {"parameters": [pid()],
+   "delete": {"operationId": "remove_last_curve", "summary": "Undo the last added curve: the next revision holds the sketch without its last curve. It is bit for bit the newest earlier revision with exactly those curves (the one before the curve was added), or, when there is none (a field created with several curves), solved afresh. Volumes keep the revision they copied.", "parameters": [timeout],
+     "responses": {"200": js(ref("Field")), "409": err("The sketch has no curve, or its only curve would leave it with neither curves nor frames (delete the field instead)."), **errs("400", "404", "422", "503", "504")}}},
  "/v1/fields/{id}/frames": {"parameters": [pid()],
    "get": {"operationId": "sample_frames", "summary": "Frames on a regular grid of points, for display.",
      "parameters": [qlist("min", "X,Y,Z world units of the first point.", {"type": "number"}, 3, True),
@@ -281,10 +298,10 @@ paths = {
    "get": {"operationId": "slice", "summary": "Axis-aligned cut: pixel (i, j) is finest voxel (u0+i, v0+j, at) for axis z, (at, u0+i, v0+j) for x, (u0+i, at, v0+j) for y. W*H at most --max-voxels (else 422).",
      "parameters": [qp("axis", "x, y or z.", {"type": "string", "enum": ["x", "y", "z"]}, True), qp("at", "Voxel index along the axis.", integer(-MAX_COORD, MAX_COORD), True),
                     qlist("origin", "U,V (default 0,0), each in [-2^28, 2^28 - 2^24].", integer(-MAX_COORD, MAX_ORIGIN), 2),
-                    qlist("size", "W,H, each in [1, 2^24].", integer(1, MAX_SIDE), 2, True), timeout],
+                    qlist("size", "W,H, each in [1, 2^24].", integer(1, MAX_SIDE), 2, True), scale_param, timeout],
      "responses": {"200": image_out, **errs("400", "404", "422", "503", "504")}}},
  "/v1/volumes/{id}/cut": {"parameters": [pid()],
-   "post": {"operationId": "cut", "summary": "Arbitrary planar cut: pixel (i, j) is the voxel nearest origin + i*u + j*v.", "parameters": [timeout],
+   "post": {"operationId": "cut", "summary": "Arbitrary planar cut: pixel (i, j) is the voxel nearest origin + i*u + j*v (in the voxels of dataset `scale`).", "parameters": [scale_param, timeout],
      "requestBody": {"required": True, "content": {"application/json": {"schema": ref("Cut")}}},
      "responses": {"200": image_out, **errs("400", "404", "413", "415", "422", "503", "504")}}},
  "/v1/volumes/{id}/region": {"parameters": [pid()],

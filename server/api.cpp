@@ -8,6 +8,7 @@
 #include "http_errors.h"
 #include "core/image_io.h"
 #include "api_json.h"
+#include "conditional_get.h"
 #include "core/json_fields.h"
 #include "openapi_document.h"
 #include "query_params.h"
@@ -160,7 +161,7 @@ Status check_plane_weights(const std::vector<double>& w, const std::string& fiel
 Api::Api(const ServerConfig& config, ExemplarService& exemplars, FieldService& fields, VolumeService& volumes,
          MeshService& meshes, Metrics& metrics, const WorkerPool& pool, const std::atomic<bool>& shutting_down)
     : config_(config), exemplars_(exemplars), fields_(fields), volumes_(volumes), meshes_(meshes), metrics_(metrics), pool_(pool),
-      chunks_(config.chunk_cache_bytes), shutting_down_(shutting_down) {}
+      chunks_(config.chunk_cache_bytes), web_(config.web_root), shutting_down_(shutting_down) {}
 
 Result<std::unique_ptr<RequestInterrupter>> Api::interrupter_for(const HttpRequest& r, const std::optional<std::string>& timeout) const {
   double seconds = config_.deadline_s;
@@ -193,6 +194,25 @@ Result<QueryResult> Api::query_volume(const HttpRequest& r, const std::string& k
   return interruptible(r, timeout, "the " + kind,
                        [&](Interrupter& i) { return volumes_.query(r.param("id"), kind, target, i, level); });
 }
+
+HttpResponse Api::static_file(const HttpRequest& r, const std::string& name) {
+  auto result = [&]() -> Result<HttpResponse> {
+    SOLIDTEX_RETURN_IF_ERROR(no_query(r));
+    SOLIDTEX_ASSIGN_OR_RETURN(StaticFile f, web_.read(name));
+    HttpResponse out;
+    out.content_type = f.content_type;
+    out.body = std::move(f.body);
+    out.headers.push_back({"ETag", f.etag});
+    // Revalidated at every load (a 304 when unchanged), so an edited app is never stale.
+    out.headers.push_back({"Cache-Control", "no-cache"});
+    return conditional_get(r, std::move(out));
+  }();
+  return result ? *result : HttpResponse::error(result.status());
+}
+
+HttpResponse Api::web_index(const HttpRequest& r) { return static_file(r, "index.html"); }
+
+HttpResponse Api::web_file(const HttpRequest& r) { return static_file(r, r.param("file")); }
 
 HttpResponse Api::healthz(const HttpRequest& r) {
   if (Status s = no_query(r); !s.is_ok()) return HttpResponse::error(s);
@@ -349,6 +369,17 @@ HttpResponse Api::add_curve(const HttpRequest& r) {
   return result ? *result : HttpResponse::error(result.status());
 }
 
+HttpResponse Api::remove_last_curve(const HttpRequest& r) {
+  auto result = [&]() -> Result<HttpResponse> {
+    SOLIDTEX_ASSIGN_OR_RETURN(QueryParams q, QueryParams::parse(r.query, {"timeout"}));
+    auto updated = interruptible(r, q.get("timeout"), "the field solve",
+                                 [&](Interrupter& i) { return fields_.remove_last_curve(r.param("id"), i); });
+    if (!updated) return updated.status();
+    return HttpResponse::json(200, *updated);
+  }();
+  return result ? *result : HttpResponse::error(result.status());
+}
+
 HttpResponse Api::sample_frames(const HttpRequest& r) {
   return respond(200, [&]() -> Result<json> {
     SOLIDTEX_ASSIGN_OR_RETURN(QueryParams q, QueryParams::parse(r.query, {"min", "size", "step"}));
@@ -380,9 +411,19 @@ HttpResponse Api::get_volume(const HttpRequest& r) { return respond(200, [&] { r
 
 HttpResponse Api::delete_volume(const HttpRequest& r) { return respond_status(volumes_.remove(r.param("id"))); }
 
+Result<int> Api::level_of_scale(const HttpRequest& r, const QueryParams& q) {
+  SOLIDTEX_ASSIGN_OR_RETURN(const int64_t scale, q.get_int("scale", 0, 0, 7));
+  if (scale == 0) return -1;
+  SOLIDTEX_ASSIGN_OR_RETURN(const VolumeService::ArrayInfo info, volumes_.array_info(r.param("id")));
+  if (scale >= info.levels)
+    return Status(StatusCode::kNotFound,
+                  "no dataset " + std::to_string(scale) + " (0.." + std::to_string(info.levels - 1) + ")", "scale");
+  return info.levels - 1 - int(scale);
+}
+
 Result<HttpResponse> Api::synthesize_image(const HttpRequest& r, const std::string& kind, const TargetSet& target,
-                                           const std::optional<std::string>& timeout) {
-  SOLIDTEX_ASSIGN_OR_RETURN(auto q, query_volume(r, kind, target, timeout));
+                                           const std::optional<std::string>& timeout, int level) {
+  SOLIDTEX_ASSIGN_OR_RETURN(auto q, query_volume(r, kind, target, timeout, level));
   const std::string shape = std::to_string(target.height) + "," + std::to_string(target.width) + ",3";
   SOLIDTEX_ASSIGN_OR_RETURN(HttpResponse out,
                             encode_colors(q.rgb, target.width, target.height, shape, negotiate(r.accept, Encoding::kPng)));
@@ -392,7 +433,7 @@ Result<HttpResponse> Api::synthesize_image(const HttpRequest& r, const std::stri
 
 HttpResponse Api::slice(const HttpRequest& r) {
   auto result = [&]() -> Result<HttpResponse> {
-    SOLIDTEX_ASSIGN_OR_RETURN(QueryParams q, QueryParams::parse(r.query, {"axis", "at", "origin", "size", "timeout"}));
+    SOLIDTEX_ASSIGN_OR_RETURN(QueryParams q, QueryParams::parse(r.query, {"axis", "at", "origin", "size", "scale", "timeout"}));
     SOLIDTEX_ASSIGN_OR_RETURN(std::string axis, q.required("axis"));
     if (axis != "x" && axis != "y" && axis != "z") return Status(StatusCode::kInvalidArgument, "must be x, y or z", "axis");
     if (!q.has("at")) return Status(StatusCode::kInvalidArgument, "is required", "at");
@@ -405,15 +446,16 @@ HttpResponse Api::slice(const HttpRequest& r) {
     SOLIDTEX_ASSIGN_OR_RETURN(auto size, q.get_int_list("size", 2));
     SOLIDTEX_RETURN_IF_ERROR(check_each(size, 1, kMaxSide, "size"));
     SOLIDTEX_RETURN_IF_ERROR(volumes_.check_target_size(sample_count(size), "size"));
+    SOLIDTEX_ASSIGN_OR_RETURN(const int level, level_of_scale(r, q));
     SOLIDTEX_ASSIGN_OR_RETURN(TargetSet target, TargetSet::axis_cut(axis[0], int(at), origin[0], origin[1], size[0], size[1]));
-    return synthesize_image(r, "slice", target, q.get("timeout"));
+    return synthesize_image(r, "slice", target, q.get("timeout"), level);
   }();
   return result ? *result : HttpResponse::error(result.status());
 }
 
 HttpResponse Api::cut(const HttpRequest& r) {
   auto result = [&]() -> Result<HttpResponse> {
-    SOLIDTEX_ASSIGN_OR_RETURN(QueryParams q, QueryParams::parse(r.query, {"timeout"}));
+    SOLIDTEX_ASSIGN_OR_RETURN(QueryParams q, QueryParams::parse(r.query, {"scale", "timeout"}));
     SOLIDTEX_RETURN_IF_ERROR(require_json_body(r));
     SOLIDTEX_ASSIGN_OR_RETURN(json j, parse_request_json(r.body, "body"));
     SOLIDTEX_RETURN_IF_ERROR(check_keys(j, {"origin", "u", "v", "size"}, ""));
@@ -427,8 +469,9 @@ HttpResponse Api::cut(const HttpRequest& r) {
     SOLIDTEX_ASSIGN_OR_RETURN(int64_t w, json_int(j["size"][0], "size", 1, kMaxCutSide));
     SOLIDTEX_ASSIGN_OR_RETURN(int64_t h, json_int(j["size"][1], "size", 1, kMaxCutSide));
     SOLIDTEX_RETURN_IF_ERROR(volumes_.check_target_size(w * h, "size"));
+    SOLIDTEX_ASSIGN_OR_RETURN(const int level, level_of_scale(r, q));
     SOLIDTEX_ASSIGN_OR_RETURN(TargetSet target, TargetSet::plane_cut(origin, u, v, int(w), int(h)));
-    return synthesize_image(r, "cut", target, q.get("timeout"));
+    return synthesize_image(r, "cut", target, q.get("timeout"), level);
   }();
   return result ? *result : HttpResponse::error(result.status());
 }

@@ -18,7 +18,9 @@
 #include "http_types.h"
 #include "mesh_service.h"
 #include "metrics.h"
+#include "query_params.h"
 #include "server_config.h"
+#include "static_files.h"
 #include "volume_service.h"
 #include "worker_pool.h"
 
@@ -29,6 +31,9 @@ class Api {
   Api(const ServerConfig& config, ExemplarService& exemplars, FieldService& fields, VolumeService& volumes,
       MeshService& meshes, Metrics& metrics, const WorkerPool& pool, const std::atomic<bool>& shutting_down);
 
+  // The browser app: GET / (index.html) and GET /web/{file} (static_files.h).
+  HttpResponse web_index(const HttpRequest& r);
+  HttpResponse web_file(const HttpRequest& r);
   HttpResponse healthz(const HttpRequest& r);
   HttpResponse metrics(const HttpRequest& r);
   HttpResponse openapi(const HttpRequest& r);
@@ -44,6 +49,7 @@ class Api {
   HttpResponse delete_field(const HttpRequest& r);
   HttpResponse get_field_file(const HttpRequest& r);
   HttpResponse add_curve(const HttpRequest& r);
+  HttpResponse remove_last_curve(const HttpRequest& r);
   HttpResponse sample_frames(const HttpRequest& r);
   HttpResponse list_volumes(const HttpRequest& r);
   HttpResponse create_volume(const HttpRequest& r);
@@ -96,9 +102,13 @@ class Api {
   HttpResponse precomputed_chunk_as(const HttpRequest& r, const std::string& format, ChunkEncoding encoding);
   Result<HttpResponse> serve_box(const HttpRequest& r, const ArrayView& view, int scale, const ChunkBox& box,
                                  const std::string& format, const std::string& key, ChunkEncoding encoding);
+  HttpResponse static_file(const HttpRequest& r, const std::string& name);
+  // The `scale` query parameter of slice and cut (dataset s of the pyramid, as /zarr's): the
+  // synthesis level to pass to query_volume (-1 for scale 0, the finest); 404 past the coarsest.
+  Result<int> level_of_scale(const HttpRequest& r, const QueryParams& q);
   HttpResponse array_metadata(const HttpRequest& r, const std::function<Result<nlohmann::json>(const ArrayView&)>& make);
   Result<HttpResponse> synthesize_image(const HttpRequest& r, const std::string& kind, const TargetSet& target,
-                                        const std::optional<std::string>& timeout);
+                                        const std::optional<std::string>& timeout, int level = -1);
 
   const ServerConfig& config_;
   ExemplarService& exemplars_;
@@ -108,6 +118,7 @@ class Api {
   Metrics& metrics_;
   const WorkerPool& pool_;
   ChunkCache chunks_;  // encoded array chunks by ETag (--chunk-cache-mb)
+  StaticFiles web_;    // --web-root
   const std::atomic<bool>& shutting_down_;
 };
 

@@ -66,7 +66,6 @@ struct FieldService::Impl {
     f.nodes = solver.nodes();
     f.log_scales = solver.log_scales();
     f.sketch_json = sketch_text;
-    SOLIDTEX_RETURN_IF_ERROR(store.write(ResourceKind::kField, id, stf_name(revision), encode_field(f)));
     json info = {{"id", id},
                  {"revision", revision},
                  {"curves", solver.curve_count()},
@@ -77,6 +76,12 @@ struct FieldService::Impl {
                  {"residual", stats.residual},
                  {"seconds", stats.seconds},
                  {"has_scales", !f.log_scales.empty()}};
+    return write_revision(id, revision, f, std::move(info), e);
+  }
+
+  // Writes `f` as revision `revision` (the .stf, then its .json holding `info`) and returns the info.
+  Result<json> write_revision(const std::string& id, int revision, const StoredField& f, json info, FieldEntry& e) {
+    SOLIDTEX_RETURN_IF_ERROR(store.write(ResourceKind::kField, id, stf_name(revision), encode_field(f)));
     SOLIDTEX_RETURN_IF_ERROR(store.write_text(ResourceKind::kField, id, json_name(revision), info.dump()));
     SOLIDTEX_ASSIGN_OR_RETURN(e.field, QuatGridField::create(f.origin, f.spacing, f.dims, f.nodes, f.log_scales));
     e.revision = revision;
@@ -241,6 +246,68 @@ Result<json> FieldService::add_curve(const std::string& id, const std::string& c
   it->second.revision = updated.revision;
   it->second.info = updated.info;
   it->second.field = updated.field;
+  it->second.solver = std::move(solver);
+  it->second.last_use = ++impl_->tick;
+  impl_->trim_solvers();
+  return info;
+}
+
+Result<json> FieldService::remove_last_curve(const std::string& id, Interrupter& interrupter) {
+  std::shared_ptr<std::mutex> busy;
+  {
+    std::lock_guard<std::mutex> g(impl_->mutex);
+    auto it = impl_->entries.find(id);
+    if (it == impl_->entries.end()) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
+    busy = it->second.busy;
+  }
+  std::lock_guard<std::mutex> one_at_a_time(*busy);
+  int revision = 0;
+  {
+    std::lock_guard<std::mutex> g(impl_->mutex);
+    auto it = impl_->entries.find(id);
+    if (it == impl_->entries.end()) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
+    revision = it->second.revision;
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  SOLIDTEX_ASSIGN_OR_RETURN(StoredField current, impl_->load_revision(id, revision));
+  SOLIDTEX_ASSIGN_OR_RETURN(Sketch sketch, parse_sketch_json(current.sketch_json));
+  if (sketch.curves.empty()) return Status(StatusCode::kFailedPrecondition, "the field has no curve to remove", "curves");
+  if (sketch.curves.size() == 1 && sketch.frames.empty())
+    return Status(StatusCode::kFailedPrecondition,
+                  "the field's only curve cannot be removed: a sketch needs a curve or a frame (delete the field instead)",
+                  "curves");
+  sketch.curves.pop_back();
+  json target = json::parse(current.sketch_json);
+  target["curves"].erase(target["curves"].end() - 1);
+  // Undo restores the newest earlier revision drawn with exactly these curves, bit for bit (an
+  // incremental solve need not equal a fresh one); a sketch never stored (a field created with
+  // several curves) is solved afresh.
+  FieldEntry updated;
+  std::unique_ptr<FieldSolver> solver;
+  json info;
+  int restored = 0;
+  for (int r = revision - 1; r >= 1 && !restored; --r) {
+    auto earlier = impl_->load_revision(id, r);
+    if (!earlier || json::parse(earlier->sketch_json, nullptr, false) != target) continue;
+    SOLIDTEX_ASSIGN_OR_RETURN(std::string text, impl_->store.read_text(ResourceKind::kField, id, json_name(r)));
+    SOLIDTEX_ASSIGN_OR_RETURN(json earlier_info, parse_json_text(text, "field info"));
+    earlier_info["revision"] = revision + 1;
+    earlier_info["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    SOLIDTEX_ASSIGN_OR_RETURN(info, impl_->write_revision(id, revision + 1, *earlier, std::move(earlier_info), updated));
+    restored = r;
+  }
+  if (!restored) {
+    FieldSolveStats stats;
+    SOLIDTEX_ASSIGN_OR_RETURN(solver, impl_->solve(sketch, interrupter, stats));
+    SOLIDTEX_ASSIGN_OR_RETURN(info, impl_->store_revision(id, revision + 1, *solver, stats, target.dump(), updated));
+  }
+  std::lock_guard<std::mutex> g(impl_->mutex);
+  auto it = impl_->entries.find(id);
+  if (it == impl_->entries.end()) return Status(StatusCode::kNotFound, "field '" + id + "' was deleted", "id");
+  it->second.revision = updated.revision;
+  it->second.info = updated.info;
+  it->second.field = updated.field;
+  // A restored revision has no live solver: the next added curve re-solves its sketch first.
   it->second.solver = std::move(solver);
   it->second.last_use = ++impl_->tick;
   impl_->trim_solvers();

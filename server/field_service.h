@@ -1,5 +1,5 @@
 // Frame fields solved from sketches (Zhang §3), stored as revisions: creation is revision 1,
-// every added curve makes the next revision (data_store.h: fields/<id>/r<N>.stf + r<N>.json).
+// every added or removed curve makes the next revision (data_store.h: fields/<id>/r<N>.stf + r<N>.json).
 // A revision never changes once written, and volumes copy the revision they use, so adding a
 // curve never alters an existing volume. The solver of a recently used field stays in memory
 // so that adding a curve re-solves incrementally (warm start); after a restart the first added
@@ -45,6 +45,11 @@ class FieldService {
   Result<nlohmann::json> create(const std::string& sketch_json, Interrupter& interrupter);
   Result<nlohmann::json> create_from_mesh(const Mesh& mesh, const MeshFieldOptions& options, Interrupter& interrupter);
   Result<nlohmann::json> add_curve(const std::string& id, const std::string& curve_json, Interrupter& interrupter);
+  // Undo of add_curve: the next revision holds the sketch without its last curve, equal bit for
+  // bit to the newest earlier revision with exactly those curves, or solved afresh when there is
+  // none. kFailedPrecondition when the sketch has no curve, or when its only curve would leave
+  // it with neither curves nor frames.
+  Result<nlohmann::json> remove_last_curve(const std::string& id, Interrupter& interrupter);
   Result<nlohmann::json> get(const std::string& id) const;
   nlohmann::json list() const;
   Status remove(const std::string& id);

@@ -154,6 +154,11 @@ class Server {
     }
     std::cerr << "solidtex serve: listening on http://" << config_.host << ":" << config_.port << " (data "
               << store_->root() << ", " << config_.threads << " workers, queue " << config_.queue << ")" << std::endl;
+    if (config_.web_root.empty())
+      std::cerr << "solidtex serve: no browser app (--web-root names its directory)" << std::endl;
+    else
+      std::cerr << "solidtex serve: browser app at http://" << config_.host << ":" << config_.port << "/ (from "
+                << config_.web_root << ")" << std::endl;
 
     int sig = 0;
     sigwait(&signals, &sig);

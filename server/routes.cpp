@@ -7,6 +7,9 @@ namespace solidtex::server {
 const std::vector<Route>& route_table() {
   using E = Execution;
   static const std::vector<Route> routes{
+      // The browser app (static_files.h): inline, so that the page loads while workers synthesize.
+      {"GET", "/", E::kInline, &Api::web_index},
+      {"GET", "/web/{file}", E::kInline, &Api::web_file},
       {"GET", "/healthz", E::kInline, &Api::healthz},
       {"GET", "/metrics", E::kInline, &Api::metrics},
       {"GET", "/v1/openapi.json", E::kInline, &Api::openapi},
@@ -22,6 +25,7 @@ const std::vector<Route>& route_table() {
       {"DELETE", "/v1/fields/{id}", E::kWorker, &Api::delete_field},
       {"GET", "/v1/fields/{id}/file", E::kWorker, &Api::get_field_file},
       {"POST", "/v1/fields/{id}/curves", E::kWorker, &Api::add_curve},
+      {"DELETE", "/v1/fields/{id}/curves/last", E::kWorker, &Api::remove_last_curve},
       {"GET", "/v1/fields/{id}/frames", E::kWorker, &Api::sample_frames},
       {"GET", "/v1/volumes", E::kInline, &Api::list_volumes},
       {"POST", "/v1/volumes", E::kWorker, &Api::create_volume},

@@ -79,5 +79,31 @@ TEST(Routes, MatchesTemplatesAndReportsAllowedMethods) {
   EXPECT_TRUE(allowed.empty());
 }
 
+TEST(Routes, TheWebAppOwnsTheRootAndWebFilesOnly) {
+  std::map<std::string, std::string> params;
+  std::vector<std::string> allowed;
+  const Route* r = match_route("GET", "/", params, allowed);
+  ASSERT_NE(r, nullptr);
+  EXPECT_STREQ(r->path, "/");
+  EXPECT_EQ(r->execution, Execution::kInline);  // the page loads while every worker synthesizes
+  r = match_route("GET", "/web/app.js", params, allowed);
+  ASSERT_NE(r, nullptr);
+  EXPECT_EQ(params.at("file"), "app.js");
+  EXPECT_EQ(r->execution, Execution::kInline);
+  // One segment only: a nested or traversing path matches no route at all.
+  allowed.clear();
+  EXPECT_EQ(match_route("GET", "/web/a/b.js", params, allowed), nullptr);
+  EXPECT_TRUE(allowed.empty());
+  EXPECT_EQ(match_route("GET", "/web/../v1/volumes", params, allowed), nullptr);
+  // The root is not a catch-all: unknown paths stay unrouted (404).
+  allowed.clear();
+  EXPECT_EQ(match_route("GET", "/index.html", params, allowed), nullptr);
+  EXPECT_TRUE(allowed.empty());
+  allowed.clear();
+  r = match_route("DELETE", "/v1/fields/fld_1/curves/last", params, allowed);
+  ASSERT_NE(r, nullptr);
+  EXPECT_EQ(params.at("id"), "fld_1");
+}
+
 }  // namespace
 }  // namespace solidtex::server

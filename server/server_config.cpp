@@ -1,5 +1,8 @@
 #include "server_config.h"
 
+#include <filesystem>
+#include <system_error>
+
 #include "synthesis/target.h"
 
 namespace solidtex::server {
@@ -34,6 +37,11 @@ Status ServerConfig::validate() const {
   if (max_field_nodes < 8 || max_field_nodes > (int64_t(1) << 24)) return out_of_range("--max-field-nodes", "[8, 2^24]");
   if (max_jobs < 1 || max_jobs > 1000) return out_of_range("--max-jobs", "[1, 1000]");
   if (analysis_threads < 1 || analysis_threads > 16) return out_of_range("--analysis-threads", "[1, 16]");
+  if (!web_root.empty()) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(std::filesystem::path(web_root) / "index.html", ec))
+      return Status(StatusCode::kInvalidArgument, "must be a directory holding index.html: " + web_root, "--web-root");
+  }
   return Status::ok();
 }
 

@@ -42,6 +42,9 @@ struct ServerConfig {
   int64_t array_extent = 1024;
   // Encoded array chunks kept for repeated reads (chunk_cache.h), bytes, [0, 64 GiB]; 0: none.
   int64_t chunk_cache_bytes = int64_t(64) << 20;
+  // Directory of the browser app (web/: index.html at /, its other files at /web/{file});
+  // empty: no app (404). `solidtex serve` defaults to the source tree's web/ (static_files.h).
+  std::string web_root;
 
   Status validate() const;
 };
