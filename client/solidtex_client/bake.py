@@ -8,7 +8,8 @@
 2. **Texels**: every texel whose centre lies in a triangle's UV image gets that centre's
    *surface point* (the triangle's barycentric weights of the centre applied to its
    mesh-coordinate corners); all of them go to the service in one ``points`` batch, each
-   distinct voxel once (:mod:`solidtex_client.surface_colors`). Such a texel is exactly the
+   distinct voxel once (:mod:`solidtex_client.surface_colors`; in compact pieces if the
+   service refuses one request as too large). Such a texel is exactly the
    service's sRGB8 encoding (:func:`~solidtex_client.srgb.encode_srgb8`) of the ``points``
    answer at its surface point, so only voxels the texture shows are synthesized.
 3. **Dilation**: ``dilate`` rings of texels around the charts take the mean linear colour of
@@ -55,7 +56,8 @@ class Bake:
     ``linear`` float32 (S, S, 3) the texel's linear colour (from the service inside charts,
     dilated or the mean outside). ``placement`` the mesh's placement in the volume. ``stats``:
     ``atlas_size``, ``texels_per_voxel``, ``charts``, ``utilization``, ``texels_baked``,
-    ``distinct_voxels``, ``voxels_synthesized``, seconds per stage, ``packings``.
+    ``distinct_voxels``, ``voxels_synthesized``, ``points_requests``, seconds per stage,
+    ``packings``.
     """
 
     positions: np.ndarray
@@ -231,7 +233,7 @@ def bake(client: "Client", volume_id: str, mesh_id: Optional[str] = None,
         "charts": int(atlas.chart_count), "utilization": float(atlas.utilization),
         "packings": packings, "texels_baked": int(inside.sum()),
         "distinct_voxels": colors.distinct_voxels,
-        "voxels_synthesized": colors.voxels_synthesized,
+        "voxels_synthesized": colors.voxels_synthesized, "points_requests": colors.requests,
         "vertices": int(len(positions)), "triangles": int(len(idx)),
         "atlas_seconds": round(t1 - t0, 3), "texel_seconds": round(t2 - t1, 3),
         "points_seconds": round(t3 - t2, 3), "texture_seconds": round(t4 - t3, 3),

@@ -502,7 +502,8 @@ class Client:
     def render_pixels(self, volume_id: str, mesh_id: Optional[str] = None,
                       mesh: Optional[MeshInput] = None, **options: Any) -> Any:
         """Render a mesh with one colour per pixel from the volume (one ``points`` batch for
-        the surface points under the pixels; only their voxels are synthesized). Give a stored
+        the surface points under the pixels, in pieces if the service refuses it as too large;
+        only their voxels are synthesized). Give a stored
         mesh's ``mesh_id`` or a ``mesh`` file (uploaded for the call, then deleted).
         ``options``: ``placement``, ``azimuth``, ``elevation``, ``size``, ``light``, ``up``,
         ``border``, ``timeout``. Returns a

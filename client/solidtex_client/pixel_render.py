@@ -5,7 +5,7 @@ the per-vertex :func:`~solidtex_client.render.render`): each object pixel gets t
 under its centre and the barycentric weights of the centre on it, hence its *surface point*,
 the weights applied to the face's three mesh-coordinate corners. All surface points go to the
 service in one ``points`` batch (:func:`~solidtex_client.surface_colors.surface_colors`: each
-distinct voxel once), so the colour is resolved per pixel at voxel resolution and only the
+distinct voxel once; compact pieces if the service refuses the batch as too large), so the colour is resolved per pixel at voxel resolution and only the
 voxels behind visible pixels (and what they depend on) are synthesized; the vertices are not.
 
 Unlit, an object pixel's sRGB8 value is exactly the service's sRGB8 encoding of the ``points``
@@ -41,8 +41,9 @@ class PixelRender:
     colour from the volume (0 for background). ``voxels`` int64 (H, W, 3): the voxel each object
     pixel shows (0 for background). ``view`` the camera, ``placement`` the mesh's placement in
     the volume, ``mesh`` the triangles rendered. ``stats``: ``object_pixels``,
-    ``distinct_voxels`` (voxels asked for), ``voxels_synthesized`` (the service's count for the
-    request), and the seconds spent rasterising, fetching and shading.
+    ``distinct_voxels`` (voxels asked for), ``voxels_synthesized`` (the service's count),
+    ``points_requests`` (1 unless the service needed pieces), and the seconds spent
+    rasterising, fetching and shading.
     """
 
     image: np.ndarray
@@ -109,7 +110,8 @@ def render_pixels(client: "Client", volume_id: str, mesh_id: Optional[str] = Non
     image[hit] = encode_srgb8(shaded)
     t3 = time.monotonic()
     stats = {"object_pixels": int(hit.sum()), "distinct_voxels": colors.distinct_voxels,
-             "voxels_synthesized": colors.voxels_synthesized, "faces": int(len(tri.faces)),
+             "voxels_synthesized": colors.voxels_synthesized,
+             "points_requests": colors.requests, "faces": int(len(tri.faces)),
              "rasterize_seconds": round(t1 - t0, 4), "points_seconds": round(t2 - t1, 4),
              "shade_seconds": round(t3 - t2, 4)}
     return PixelRender(image, face, surface, linear, voxels, view, place, tri, stats)

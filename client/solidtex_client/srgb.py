@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import ctypes
 import ctypes.util
+import functools
 import math
 from typing import Any, Callable, Optional
 
@@ -41,6 +42,7 @@ def _libm_powf() -> Optional[Callable[[float, float], float]]:
     return powf
 
 
+@functools.lru_cache(maxsize=1)
 def _encoder() -> Callable[[np.float32], int]:
     """The service's code of one float32 value (the module doc's formula)."""
     powf = _libm_powf()
