@@ -13,7 +13,7 @@ from PIL import Image
 
 from mesh_shapes import obj_bytes, torus
 from support import fake_response  # (support also puts <repo>/client on sys.path)
-from solidtex_client import Client
+from solidtex_client import BadRequest, Client, Unprocessable
 from solidtex_client import bake as bake_module
 from solidtex_client.cli import main as cli_main
 from solidtex_client.gltf import write_glb
@@ -274,6 +274,57 @@ def test_bake_pipeline_offline():
     (geom,) = scene.geometry.values()
     assert np.array_equal(np.asarray(geom.visual.material.baseColorTexture.convert("RGB")),
                           out.texture)
+
+
+class RefusingService(FakeService):
+    """Refuses points requests of more than ``limit`` voxels, or spanning more than ``span``
+    voxels along an axis, as the service does over its working-memory limit (422, field
+    ``size``; ``status`` changes the status)."""
+
+    def __init__(self, verts, faces, limit, span):
+        super().__init__(verts, faces)
+        self.limit, self.span, self.refused, self.status = limit, span, 0, 422
+
+    def send(self, request, **kwargs):
+        if urlsplit(request.url).path.endswith("/points"):
+            pts = np.frombuffer(request.body, "<f4").reshape(-1, 3)
+            if len(pts) > self.limit or (pts.max(0) - pts.min(0)).max() > self.span:
+                self.refused += 1
+                r = fake_response(self.status, {"error": {
+                    "code": "unprocessable", "field": "size", "message": "needs up to 3417 MB"}})
+                r.request = request
+                return r
+        return super().send(request, **kwargs)
+
+
+def test_refused_batches_are_split_into_compact_pieces():
+    verts, faces = torus(30, 14)
+    whole = FakeService(verts, faces)
+    want = Client("http://fake", session=whole).render_pixels(
+        "vol_1", mesh_id="mesh_1", placement={"resolution": 64}, size=(80, 80), light=False)
+    fake = RefusingService(verts, faces, limit=700, span=30)
+    c = Client("http://fake", session=fake)
+    got = c.render_pixels("vol_1", mesh_id="mesh_1", placement={"resolution": 64},
+                          size=(80, 80), light=False)
+    print(got.stats, fake.refused)
+    assert np.array_equal(got.image, want.image)
+    pieces = fake.points_bodies
+    assert got.stats["points_requests"] == len(pieces) > 1 and fake.refused >= 1
+    sent = np.concatenate(pieces)
+    assert len(sent) == len(np.unique(sent, axis=0)) == got.stats["distinct_voxels"]
+    assert got.stats["voxels_synthesized"] == 7 * len(sent)
+    assert all(len(p) <= 700 and (p.max(0) - p.min(0)).max() <= 30 for p in pieces)
+    # a single voxel refused is raised; so is any other error, at once
+    nothing = RefusingService(verts, faces, limit=0, span=0)
+    with pytest.raises(Unprocessable):
+        Client("http://fake", session=nothing).render_pixels(
+            "vol_1", mesh_id="mesh_1", placement={"resolution": 64}, size=(8, 8))
+    bad = RefusingService(verts, faces, limit=0, span=0)
+    bad.status = 400
+    with pytest.raises(BadRequest):
+        Client("http://fake", session=bad).render_pixels(
+            "vol_1", mesh_id="mesh_1", placement={"resolution": 64}, size=(8, 8))
+    assert bad.refused == 1
 
 
 @pytest.mark.parametrize("kwargs,word", [
