@@ -38,15 +38,21 @@ if [ -z "$volume" ]; then
            -d "{\"name\": \"demo-wood\", \"exemplar\": \"$exemplar\", \"field\": {\"spec\": \"axis:0,0,1,30\"}, \"seed\": 1}" \
            "$url/v1/volumes" | json "d['id']")
 fi
-# Warm the cache with the first cut suggested below, so that it answers at once (a new cut
-# costs tens of seconds on 2 cores; repeats and overlapping cuts reuse the cached voxels).
+# Warm the cache with the browser app's first view (its 256² z cut at 0 and the 32² preview of
+# pyramid dataset 3 it shows first), so that it and the cut suggested below answer at once (a
+# new cut costs seconds to tens of seconds on 2 cores; repeats and overlapping cuts reuse the
+# cached voxels).
 cut="$url/v1/volumes/$volume/slice?axis=z&at=0&size=96,96"
-if ! curl -sf -o "$demo/cut_z.png" "$cut&timeout=300"; then echo "warning: the warm-up cut failed" >&2; fi
+for warm in "size=32,32&scale=3" "size=256,256"; do
+  curl -sf -o /dev/null "$url/v1/volumes/$volume/slice?axis=z&at=0&$warm&timeout=300" ||
+    echo "warning: the warm-up cut ($warm) failed" >&2
+done
 
 cat <<MSG
 
 solidtex is serving on $url (data in $data); demo volume: $volume
-try:
+open the browser app: $url/#volume=$volume
+or try:
   curl -o cut.png  "$cut"                      (cached: instant)
   curl -o side.png "$url/v1/volumes/$volume/slice?axis=y&at=5&size=96,48"
   curl -o box.vdb  "$url/v1/volumes/$volume/region?min=0,0,0&size=24,24,24"
