@@ -72,21 +72,36 @@ export const addCurve = (fieldId, curve) =>
   callJson("POST", `/v1/fields/${encodeURIComponent(fieldId)}/curves`, { json: curve });
 export const removeLastCurve = (fieldId) => callJson("DELETE", `/v1/fields/${encodeURIComponent(fieldId)}/curves/last`);
 
+let deadline = null;
+
+// The longest deadline this server grants, in seconds (its --max-deadline: the served contract
+// states it as the maximum of every `timeout` parameter); undefined when unknown (the server's
+// default deadline applies). Cuts and surfaces ask for it: a new cut of a sketched field can
+// take minutes on a small machine, and the app cancels whatever it stops showing anyway.
+export function maxDeadline() {
+  if (!deadline)
+    deadline = callJson("GET", "/v1/openapi.json")
+      .then((doc) => doc.paths["/v1/volumes/{id}/slice"].get.parameters.find((p) => p.name === "timeout").schema.maximum)
+      .catch(() => undefined);
+  return deadline;
+}
+
 // A cut as raw sRGB8: {width, height, rgb (Uint8Array, row-major RGB), voxels (synthesized by
 // this request)}. `request`: {kind: "slice", axis, at, origin, size} or {kind: "cut", origin, u, v,
 // size}, in the voxels of dataset `scale`.
 export async function cutPixels(volumeId, request, scale, signal) {
   const base = `/v1/volumes/${encodeURIComponent(volumeId)}`;
   const accept = "application/octet-stream";
+  const timeout = await maxDeadline();
   const response =
     request.kind === "slice"
       ? await call("GET", base + "/slice", {
-          params: { axis: request.axis, at: request.at, origin: request.origin, size: request.size, scale: scale || undefined },
+          params: { axis: request.axis, at: request.at, origin: request.origin, size: request.size, scale: scale || undefined, timeout },
           accept,
           signal,
         })
       : await call("POST", base + "/cut", {
-          params: { scale: scale || undefined },
+          params: { scale: scale || undefined, timeout },
           json: { origin: request.origin, u: request.u, v: request.v, size: request.size },
           accept,
           signal,
@@ -101,6 +116,7 @@ export async function cutPixels(volumeId, request, scale, signal) {
 // A stored mesh coloured by a volume: the PLY bytes (ArrayBuffer) and the voxels synthesized.
 export async function surfacePly(volumeId, meshId, resolution, signal) {
   const response = await call("POST", `/v1/volumes/${encodeURIComponent(volumeId)}/surface`, {
+    params: { timeout: await maxDeadline() },
     json: { mesh: meshId, placement: { resolution }, format: "ply" },
     signal,
   });

@@ -16,6 +16,7 @@ import { parsePly } from "./ply.js";
 import { SketchTool } from "./sketch.js";
 
 const $ = (id) => document.getElementById(id);
+const plural = (n, word) => `${n} ${word}${n === 1 ? "" : "s"}`;
 const JOB_POLL_MS = 200;
 const RENDER_DELAY_MS = 80;
 // Cells along a new sketch field's shortest side: coarse enough to solve at once, smooth anyway.
@@ -104,7 +105,7 @@ async function refreshFields() {
   fillSelect($("volume-field"), [
     ["identity", "identity"],
     ["spec", "constant (spec)"],
-    ...fields.map((f) => [f.id, `${f.id} r${f.revision}, ${f.curves} curves`]),
+    ...fields.map((f) => [f.id, `${f.id} r${f.revision}, ${plural(f.curves, "curve")}`]),
   ]);
   $("volume-spec-row").hidden = $("volume-field").value !== "spec";
 }
@@ -300,7 +301,7 @@ async function addStroke(curve) {
       throw e;
     }
     state.undo.push({ from: from.id, to: volume.id, fieldId: field.id, createdField, curve });
-    say(`curve added: field ${field.id} revision ${field.revision} (${field.curves} curves, solved in ${Number(field.seconds || 0).toFixed(2)} s)`, true);
+    say(`curve added: field ${field.id} revision ${field.revision} (${plural(field.curves, "curve")}, solved in ${Number(field.seconds || 0).toFixed(2)} s)`, true);
     refreshVolumes().catch(() => {});
     refreshFields().catch(() => {});
     state.sketchBusy = false;
@@ -319,7 +320,7 @@ async function undoStroke() {
     const shown = showVolume(last.from, { keepUndo: true });
     const field = last.createdField ? await api.deleteField(last.fieldId) : await api.removeLastCurve(last.fieldId);
     await api.deleteVolume(last.to);
-    say(last.createdField ? `undone: deleted the sketch field ${last.fieldId}` : `undone: field ${field.id} revision ${field.revision} (${field.curves} curves)`, true);
+    say(last.createdField ? `undone: deleted the sketch field ${last.fieldId}` : `undone: field ${field.id} revision ${field.revision} (${plural(field.curves, "curve")})`, true);
     refreshVolumes().catch(() => {});
     refreshFields().catch(() => {});
     await shown;
@@ -370,9 +371,10 @@ $("mesh-show").addEventListener(
 // ---- start -------------------------------------------------------------------------------
 
 async function start() {
+  api.maxDeadline();  // fetched while the rest loads: every cut asks for it
   const wanted = readHash();
   syncCutControls();
-  const lists = refreshAll();
+  const lists = refreshAll().catch((e) => say(e.message));
   if (wanted) {
     await showVolume(wanted);
   } else {
