@@ -3,7 +3,7 @@
     solidtex-client [--url URL] upload IMAGE [--yz IMG --zx IMG --mask IMG] [--levels L ...] [--wait]
     solidtex-client field SKETCH.json
     solidtex-client volume --exemplar ID [--field-id ID | --field-spec SPEC] [--seed S] [--scheme S]
-    solidtex-client slice VOLUME --axis z --at K --size W,H [--origin U,V] -o OUT.png
+    solidtex-client slice VOLUME --axis z --at K --size W,H [--origin U,V] [--scale S] -o OUT.png
     solidtex-client region VOLUME --min X,Y,Z --size W,H,D -o OUT.vdb|OUT.npy
     solidtex-client points VOLUME POINTS.npy|POINTS.txt -o OUT.npy|OUT.txt
     solidtex-client mesh MESH.obj|.ply|.off [--name N]
@@ -100,6 +100,10 @@ def _parser() -> argparse.ArgumentParser:
     sl.add_argument("--at", required=True, type=int)
     sl.add_argument("--size", required=True, type=_ints(2), metavar="W,H")
     sl.add_argument("--origin", type=_ints(2), default=[0, 0], metavar="U,V")
+    sl.add_argument("--scale", type=int, default=0, metavar="S",
+                    help="pyramid dataset (as the zarr views'): 0 (default) the finest voxels, "
+                         "S > 0 a coarser level whose voxels are 2^S finest wide; --at, "
+                         "--origin and --size then count its voxels")
     sl.add_argument("--timeout", type=float, help="server deadline, seconds")
     sl.add_argument("-o", "--output", required=True)
 
@@ -221,7 +225,7 @@ def _run(args: argparse.Namespace) -> None:
                                          params=params or None, seed=args.seed, name=args.name))
     elif args.command == "slice":
         png = client.slice(args.volume, args.axis, args.at, args.size, origin=args.origin,
-                           dtype="png_bytes", timeout=args.timeout)
+                           dtype="png_bytes", timeout=args.timeout, scale=args.scale)
         with open(args.output, "wb") as f:
             f.write(png)
     elif args.command == "region":

@@ -1,7 +1,8 @@
 """HTTP client for the solidtex service: one method per operation of proto/openapi.json.
 
-Units: world coordinates and sizes are finest-level voxels; timeouts and deadlines are
-seconds. Colors: ``uint8`` answers are sRGB-encoded 8-bit, ``float32`` answers are linear RGB.
+Units: world coordinates and sizes are finest-level voxels (a ``slice`` or ``cut`` with
+``scale=s`` counts the voxels of pyramid dataset s); timeouts and deadlines are seconds.
+Colors: ``uint8`` answers are sRGB-encoded 8-bit, ``float32`` answers are linear RGB.
 Every error answer raises the :mod:`solidtex_client.errors` exception for its status.
 """
 from __future__ import annotations
@@ -155,6 +156,15 @@ def _query_value(v: Any) -> str:
 def _rows(values: Any, width: int, dtype: Any = np.float64) -> np.ndarray:
     """``values`` (nested sequences or an array) as an (N, ``width``) array of ``dtype``."""
     return np.asarray(values, dtype=np.float64).reshape(-1, width).astype(dtype, copy=False)
+
+
+def _scale(scale: Any) -> int:
+    """``scale`` checked as a pyramid dataset index: a non-negative integer."""
+    if isinstance(scale, (bool, np.bool_)) or not isinstance(scale, (int, np.integer)):
+        raise TypeError(f"scale must be a non-negative integer, got {scale!r}")
+    if scale < 0:
+        raise ValueError(f"scale must be a non-negative integer, got {int(scale)}")
+    return int(scale)
 
 
 def _accept(formats: Mapping[str, str], fmt: str, what: str) -> str:
@@ -374,6 +384,17 @@ class Client:
         return self._timed("POST", f"/v1/fields/{field_id}/curves", timeout,
                            json=dict(curve)).json()
 
+    def undo_curve(self, field_id: str, timeout: Optional[float] = None) -> Dict[str, Any]:
+        """DELETE /v1/fields/{id}/curves/last: remove the sketch's last curve (revision + 1).
+
+        The new revision is bit for bit the newest earlier one with the same curves, else
+        solved afresh; volumes keep the revision they copied. Returns the Field. A sketch
+        the removal would leave empty raises
+        :class:`~solidtex_client.errors.Conflict` (409). ``timeout`` is the server-side
+        deadline in seconds.
+        """
+        return self._timed("DELETE", f"/v1/fields/{field_id}/curves/last", timeout).json()
+
     def sample_frames(self, field_id: str, min: Sequence[float], size: Sequence[int],
                       step: float = 1.0) -> Dict[str, Any]:
         """GET /v1/fields/{id}/frames: frames on a grid of ``size`` = (NX, NY, NZ) points
@@ -580,34 +601,46 @@ class Client:
 
     def slice(self, volume_id: str, axis: str, at: int, size: Sequence[int],
               origin: Sequence[int] = (0, 0), dtype: str = "uint8",
-              timeout: Optional[float] = None) -> Any:
+              timeout: Optional[float] = None, scale: int = 0) -> Any:
         """GET /v1/volumes/{id}/slice: an axis-aligned cut of ``size`` = (W, H) pixels.
 
-        Pixel (i, j) is finest voxel (U+i, V+j, at) for axis z, (at, U+i, V+j) for x,
+        Pixel (i, j) is voxel (U+i, V+j, at) for axis z, (at, U+i, V+j) for x,
         (U+i, at, V+j) for y, with ``origin`` = (U, V). ``dtype``: ``"uint8"`` -> sRGB
         uint8 array (H, W, 3); ``"float32"`` -> linear float32 array (H, W, 3); ``"png"`` ->
         ``PIL.Image``; ``"png_bytes"`` -> the PNG bytes as sent. ``timeout`` is the
         server-side deadline in seconds (504 past it).
+
+        ``scale``: dataset s of the volume's pyramid, as in the zarr views: 0 (default) the
+        finest voxels; s > 0 a coarser synthesis level whose voxels are 2^s finest voxels
+        wide, and ``at``, ``origin`` and ``size`` count that level's voxels (a fast preview:
+        nothing finer is synthesized). A non-negative integer (else ``TypeError`` or
+        ``ValueError``); past the volume's coarsest dataset the server answers 404
+        (:class:`~solidtex_client.errors.NotFound`).
         """
         accept = _accept(_CUT_ACCEPT, dtype, "dtype")
         params = {"axis": axis, "at": int(at), "origin": list(origin), "size": list(size)}
+        scale = _scale(scale)
+        if scale:
+            params["scale"] = scale
         r = self._timed("GET", f"/v1/volumes/{volume_id}/slice", timeout, params=params,
                         headers={"Accept": accept})
         return _binary_answer(r, dtype)
 
     def cut(self, volume_id: str, origin: Sequence[float], u: Sequence[float],
             v: Sequence[float], size: Sequence[int], dtype: str = "uint8",
-            timeout: Optional[float] = None) -> Any:
+            timeout: Optional[float] = None, scale: int = 0) -> Any:
         """POST /v1/volumes/{id}/cut: a planar cut; pixel (i, j) is the voxel nearest
-        ``origin + i*u + j*v`` (world units = finest voxels), ``size`` = (W, H).
+        ``origin + i*u + j*v`` (in voxels of dataset ``scale``: finest voxels for the
+        default 0), ``size`` = (W, H).
 
-        ``dtype`` and ``timeout`` as for :meth:`slice`.
+        ``dtype``, ``timeout`` and ``scale`` as for :meth:`slice`.
         """
         accept = _accept(_CUT_ACCEPT, dtype, "dtype")
+        scale = _scale(scale)
         body = {"origin": [float(x) for x in origin], "u": [float(x) for x in u],
                 "v": [float(x) for x in v], "size": [int(x) for x in size]}
         r = self._timed("POST", f"/v1/volumes/{volume_id}/cut", timeout, json=body,
-                        headers={"Accept": accept})
+                        params={"scale": scale or None}, headers={"Accept": accept})
         return _binary_answer(r, dtype)
 
     def region(self, volume_id: str, min: Sequence[int], size: Sequence[int],

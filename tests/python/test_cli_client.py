@@ -57,3 +57,17 @@ def test_cli_upload_field_volume_region_points(shared, exemplars, tmp_path):
     assert np.array_equal(rgb[0], box[0, 0, 0])
     assert np.array_equal(rgb[1], box[3, 4, 5])
     assert np.array_equal(rgb[2], box[0, 1, 2])
+
+
+def test_cli_slice_scale_is_the_clients(shared, tmp_path):
+    levels = shared.exemplar["params"]["levels"]
+    out = tmp_path / "coarse.png"
+    client_cli(shared.server.url, "slice", shared.volume_id, "--axis", "x", "--at", "-40",
+               "--origin=-60,-60", "--size", "12,8", "--scale", levels - 1, "-o", out)
+    assert Image.open(out).size == (12, 8)
+    want = shared.client.slice(shared.volume_id, "x", -40, (12, 8), origin=(-60, -60), scale=levels - 1)
+    assert np.array_equal(file_pixels(out), want)
+    proc = client_cli(shared.server.url, "slice", shared.volume_id, "--axis", "x", "--at", "0",
+                      "--size", "4,4", "--scale", levels, "-o", tmp_path / "x.png", check=False)
+    assert proc.returncode == 1 and proc.stderr.startswith("error: not_found: "), proc.stderr
+    assert "(scale)" in proc.stderr and not (tmp_path / "x.png").exists()

@@ -220,3 +220,66 @@ def test_cli_volume_scheme_and_number_lists(capsys, monkeypatch):
         assert info.value.code == 2
         assert needle in capsys.readouterr().err, argv
     assert len(session.sent) == 1
+
+
+def test_scale_goes_in_the_query_of_slice_and_cut():
+    pix = bytes(2 * 3 * 3)
+    s = FakeSession([fake_response(200, pix, {"X-Shape": "2,3,3"}) for _ in range(4)])
+    c = Client("http://svc:1", session=s)
+    c.slice("v", "z", 3, (3, 2), scale=2)
+    assert parse_qs(urlsplit(s.sent[0].url).query)["scale"] == ["2"]
+    c.slice("v", "z", 3, (3, 2), scale=np.int64(0))           # the default is not sent
+    assert "scale" not in parse_qs(urlsplit(s.sent[1].url).query)
+    c.cut("v", (0, 0, 1), (1, 0, 0), (0, 1, 0), (3, 2), scale=np.uint8(1), timeout=4)
+    assert parse_qs(urlsplit(s.sent[2].url).query) == {"scale": ["1"], "timeout": ["4"]}
+    assert json.loads(s.sent[2].body) == {"origin": [0, 0, 1], "u": [1, 0, 0], "v": [0, 1, 0],
+                                         "size": [3, 2]}, "scale is a query parameter, not a body key"
+    c.cut("v", (0, 0, 1), (1, 0, 0), (0, 1, 0), (3, 2))
+    assert urlsplit(s.sent[3].url).query == ""
+
+
+@pytest.mark.parametrize("bad, error", [(-1, ValueError), (np.int32(-2), ValueError),
+                                        (1.0, TypeError), (1.5, TypeError), ("1", TypeError),
+                                        (True, TypeError), (None, TypeError)])
+def test_bad_scale_raises_naming_it_before_sending(bad, error):
+    s = FakeSession([])
+    c = Client("http://svc:1", session=s)
+    for call in (lambda: c.slice("v", "z", 0, (1, 1), scale=bad),
+                 lambda: c.cut("v", (0, 0, 0), (1, 0, 0), (0, 1, 0), (1, 1), scale=bad)):
+        with pytest.raises(error, match="scale must be a non-negative integer"):
+            call()
+    assert s.sent == []
+
+
+def test_undo_curve_request_and_answer():
+    fld = {"id": "fld_1", "revision": 3, "curves": 1}
+    s = FakeSession([fake_response(200, fld), fake_response(200, fld),
+                     fake_response(409, {"error": {"code": "failed_precondition",
+                                                   "message": "the sketch would be empty",
+                                                   "field": "curves"}})])
+    c = Client("http://svc:1", session=s)
+    assert c.undo_curve("fld_1") == fld
+    assert s.sent[0].method == "DELETE"
+    assert urlsplit(s.sent[0].url).path == "/v1/fields/fld_1/curves/last"
+    assert urlsplit(s.sent[0].url).query == "" and not s.sent[0].body
+    c.undo_curve("fld_1", timeout=90)
+    assert parse_qs(urlsplit(s.sent[1].url).query) == {"timeout": ["90"]}
+    with pytest.raises(Conflict) as info:
+        c.undo_curve("fld_1")
+    assert info.value.field == "curves"
+
+
+def test_cli_slice_scale(capsys, monkeypatch, tmp_path):
+    png = encode_png(np.zeros((2, 3, 3), np.uint8))
+    session = FakeSession([fake_response(200, png, {"Content-Type": "image/png"})])
+    monkeypatch.setattr(cli_module, "Client",
+                        lambda url, timeout: Client(url, timeout=timeout, session=session))
+    out = tmp_path / "s.png"
+    assert cli_main(["--url", "http://svc:1", "slice", "v", "--axis", "z", "--at", "1",
+                     "--size", "3,2", "--scale", "2", "-o", str(out)]) == 0
+    assert out.read_bytes() == png
+    assert parse_qs(urlsplit(session.sent[0].url).query)["scale"] == ["2"]
+    assert cli_main(["--url", "http://svc:1", "slice", "v", "--axis", "z", "--at", "1",
+                     "--size", "3,2", "--scale", "-1", "-o", str(tmp_path / "x.png")]) == 1
+    assert "scale must be a non-negative integer" in capsys.readouterr().err
+    assert len(session.sent) == 1 and not (tmp_path / "x.png").exists()

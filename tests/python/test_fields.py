@@ -1,9 +1,11 @@
-"""Frame fields from sketches: create, add curves, sample, download, use in volumes."""
+"""Frame fields from sketches: create, add and undo curves, sample, download, use in volumes."""
 import copy
 
 import numpy as np
+import pytest
 import requests
 
+from solidtex_client import Conflict, NotFound
 from support import assert_error, file_pixels, png_pixels, run_cli
 
 # One straight curve along the diagonal x = y (in the plane z = 16): the frame's x axis
@@ -117,3 +119,47 @@ def test_quaternion_spec_volume_matches_cli(shared, tmp_path):
     run_cli("slice", shared.table_path, "--axis", "z", "--at", "0", "--size", "24,16",
             "--seed", "7", "--field", spec, "-o", out)
     assert np.array_equal(file_pixels(out), png_pixels(png))
+
+
+def test_undo_curve_through_the_client_is_the_raw_route(shared):
+    """Client.undo_curve answers the Field of DELETE /v1/fields/{id}/curves/last: the new
+    revision is the one before the curve, a volume keeps the revision it copied, and the
+    errors are the typed ones naming what is wrong."""
+    c, url = shared.client, shared.server.url
+    fid = c.create_field(SKETCH)["id"]
+    rev1 = c.get_field_file(fid)
+    assert c.add_curve(fid, CURVE2)["revision"] == 2
+    vol = c.create_volume(exemplar=shared.exemplar_id, field={"id": fid}, seed=7)
+
+    undone = c.undo_curve(fid)
+    assert c.last_response.status_code == 200
+    assert undone["id"] == fid and undone["revision"] == 3 and undone["curves"] == 1, undone
+    assert undone == c.get_field(fid)
+    assert c.get_field_file(fid) == rev1
+
+    # the raw route on a twin field: the same answer but for the id and the solve time, the
+    # same file bytes
+    twin = c.create_field(SKETCH)["id"]
+    c.add_curve(twin, CURVE2)
+    raw = requests.delete(f"{url}/v1/fields/{twin}/curves/last", timeout=60)
+    assert raw.status_code == 200, raw.text
+
+    def same(d):
+        return {k: v for k, v in d.items() if k not in ("id", "seconds")}
+    assert same(raw.json()) == same(undone)
+    assert c.get_field_file(twin) == rev1
+
+    # the volume made from revision 2 keeps it
+    assert c.get_volume(vol["id"])["field"] == {"kind": "stored", "id": fid, "revision": 2}
+
+    # one curve left: nothing removed, no new revision
+    with pytest.raises(Conflict) as info:
+        c.undo_curve(fid)
+    assert info.value.status == 409 and info.value.field == "curves", info.value
+    assert c.get_field(fid)["revision"] == 3
+    with pytest.raises(NotFound) as info:
+        c.undo_curve("fld_nothing")
+    assert info.value.field == "id", info.value
+    c.delete_volume(vol["id"])
+    for f in (fid, twin):
+        c.delete_field(f)

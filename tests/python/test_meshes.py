@@ -75,11 +75,14 @@ def contract_placement(bounds, resolution=RES, margin=MARGIN):
 
 
 def lround(x):
-    """C's lround (halves away from zero), exactly, for float64 arrays."""
+    """C's lround (halves away from zero), exactly, for float64 arrays (as the client's
+    solidtex_client.placement.lround)."""
     x = np.asarray(x, np.float64)
-    f = np.floor(x)
-    d = x - f                       # exact
-    return f + (d > 0.5) + ((d == 0.5) & (x > 0))
+    a = np.abs(x)
+    f = np.floor(a)
+    # a - floor(a) is exact for a >= 0; x - floor(x) is not for x < 0 (-0.49999999999999994
+    # + 1 rounds to 0.5, which made this -1 where lround gives 0)
+    return np.copysign(f + (a - f >= 0.5), x)
 
 
 def bounding_voxels(bounds, scale, translate):

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 import requests
 
-from solidtex_client import BadRequest, Unprocessable
-from support import RAW, assert_error, file_pixels, png_pixels, run_cli, solidtex_bin, srgb8
+from solidtex_client import BadRequest, NotFound, Unprocessable
+from support import RAW, RAW_F32, assert_error, file_pixels, png_pixels, run_cli, solidtex_bin, srgb8
 
 OBLIQUE = dict(origin=(1, 2, 3), u=(0.6, 0.8, 0), v=(-0.48, 0.36, 0.8), size=(32, 24))
 
@@ -146,6 +146,56 @@ def test_cut_matches_cli_plane_and_slice(shared, tmp_path):
     # an axis-aligned cut is the slice
     flat = c.cut(vid, origin=(0, 0, 3), u=(1, 0, 0), v=(0, 1, 0), size=(32, 24), dtype="float32")
     assert np.array_equal(flat, c.slice(vid, "z", 3, (32, 24), dtype="float32"))
+
+
+def test_scale_slice_and_cut_are_the_raw_routes_bytes(shared):
+    """``scale=s`` on Client.slice and Client.cut gives the bytes of the raw routes with
+    scale=s, for every dataset of the pyramid and every answer type."""
+    c, vid = shared.client, shared.volume_id
+    base = f"{shared.server.url}/v1/volumes/{vid}"
+    levels = shared.exemplar["params"]["levels"]
+    cut = dict(origin=(-70, -90, 40), u=(0.8, 0, 0.6), v=(0, 1, 0), size=(12, 10))
+    cut_body = {"origin": list(cut["origin"]), "u": list(cut["u"]), "v": list(cut["v"]), "size": [12, 10]}
+    slices = []
+    for scale in range(levels):
+        params = {"axis": "y", "at": -90, "origin": "-70,40", "size": "12,10", "scale": scale}
+        raw = requests.get(f"{base}/slice", params=params, headers=RAW, timeout=60)
+        assert raw.status_code == 200, raw.text
+        u8 = c.slice(vid, "y", -90, (12, 10), origin=(-70, 40), scale=scale)
+        assert u8.shape == (10, 12, 3) and u8.tobytes() == raw.content, scale
+        raw_f32 = requests.get(f"{base}/slice", params=params, headers=RAW_F32, timeout=60)
+        f32 = c.slice(vid, "y", -90, (12, 10), origin=(-70, 40), scale=scale, dtype="float32")
+        assert f32.astype("<f4").tobytes() == raw_f32.content, scale
+        raw_png = requests.get(f"{base}/slice", params=params, timeout=60)
+        assert c.slice(vid, "y", -90, (12, 10), origin=(-70, 40), scale=scale, dtype="png_bytes") == raw_png.content
+        slices.append(u8)
+
+        raw_cut = requests.post(f"{base}/cut", params={"scale": scale}, json=cut_body, headers=RAW, timeout=60)
+        assert raw_cut.status_code == 200, raw_cut.text
+        got = c.cut(vid, **cut, scale=scale)
+        assert got.shape == (10, 12, 3) and got.tobytes() == raw_cut.content, scale
+        # an axis-aligned cut of the dataset is its slice
+        flat = c.cut(vid, origin=(-70, -90, 40), u=(1, 0, 0), v=(0, 0, 1), size=(12, 10), scale=scale)
+        assert np.array_equal(flat, u8), scale
+    assert not np.array_equal(slices[0], slices[-1]), "the coarsest dataset is the finest again"
+
+    # bad scales: refused by the client before sending, or by the server naming the parameter
+    sent = c.last_response
+    for bad, error in ((-1, ValueError), (1.5, TypeError), ("1", TypeError)):
+        with pytest.raises(error, match="scale"):
+            c.slice(vid, "y", -90, (12, 10), scale=bad)
+        with pytest.raises(error, match="scale"):
+            c.cut(vid, **cut, scale=bad)
+    assert c.last_response is sent, "a bad scale was sent"
+    with pytest.raises(NotFound) as info:
+        c.slice(vid, "y", -90, (12, 10), scale=levels)
+    assert info.value.field == "scale" and f"0..{levels - 1}" in info.value.message, info.value
+    with pytest.raises(NotFound) as info:
+        c.cut(vid, **cut, scale=levels)
+    assert info.value.field == "scale", info.value
+    with pytest.raises(BadRequest) as info:                  # past the contract's maximum, 7
+        c.slice(vid, "y", -90, (12, 10), scale=8)
+    assert info.value.field == "scale", info.value
 
 
 def test_points_region_slice_agree(shared):
