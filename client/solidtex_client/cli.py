@@ -23,6 +23,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import re
 import sys
 from typing import Any, Callable, List, Optional, Sequence
 
@@ -311,9 +312,28 @@ def _render(client: Client, args: argparse.Namespace) -> None:
     _print_json(summary)
 
 
+_NEGATIVE_VALUE = re.compile(r"^-[0-9.]")
+
+
+def attach_negative_values(argv: Sequence[str]) -> List[str]:
+    """``--origin -60,-60`` -> ``--origin=-60,-60``.
+
+    argparse reads a token starting with ``-`` as an option unless it is a single negative
+    number, so comma lists of coordinates (``--min -8,0,0``) would be refused; no option
+    of ours starts with a digit, so such a token is always the previous option's value.
+    """
+    out: List[str] = []
+    for token in argv:
+        if (out and _NEGATIVE_VALUE.match(token) and out[-1].startswith("--") and "=" not in out[-1]):
+            out[-1] = f"{out[-1]}={token}"
+        else:
+            out.append(token)
+    return out
+
+
 def main(argv: Optional[Sequence[str]] = None) -> int:
     """Entry point; returns the process exit status (0, or 1 on any error)."""
-    args = _parser().parse_args(argv)
+    args = _parser().parse_args(attach_negative_values(sys.argv[1:] if argv is None else list(argv)))
     try:
         _run(args)
     except SolidtexError as e:

@@ -283,3 +283,17 @@ def test_cli_slice_scale(capsys, monkeypatch, tmp_path):
                      "--size", "3,2", "--scale", "-1", "-o", str(tmp_path / "x.png")]) == 1
     assert "scale must be a non-negative integer" in capsys.readouterr().err
     assert len(session.sent) == 1 and not (tmp_path / "x.png").exists()
+
+
+def test_cli_takes_negative_coordinate_lists_after_their_option(monkeypatch, tmp_path):
+    assert cli_module.attach_negative_values(["--origin", "-60,-60", "--at", "-4", "-o", "x"]) == \
+        ["--origin=-60,-60", "--at=-4", "-o", "x"]
+    assert cli_module.attach_negative_values(["--min=-1,0,0", "-o", "-5"]) == ["--min=-1,0,0", "-o", "-5"]
+    png = encode_png(np.zeros((2, 3, 3), np.uint8))
+    session = FakeSession([fake_response(200, png, {"Content-Type": "image/png"})])
+    monkeypatch.setattr(cli_module, "Client",
+                        lambda url, timeout: Client(url, timeout=timeout, session=session))
+    assert cli_main(["--url", "http://svc:1", "slice", "v", "--axis", "x", "--at", "-40",
+                     "--origin", "-60,-60", "--size", "3,2", "-o", str(tmp_path / "s.png")]) == 0
+    query = parse_qs(urlsplit(session.sent[0].url).query)
+    assert query["at"] == ["-40"] and query["origin"] == ["-60,-60"]
