@@ -38,9 +38,14 @@ Status ServerConfig::validate() const {
   if (max_jobs < 1 || max_jobs > 1000) return out_of_range("--max-jobs", "[1, 1000]");
   if (analysis_threads < 1 || analysis_threads > 16) return out_of_range("--analysis-threads", "[1, 16]");
   if (!web_root.empty()) {
+    // symlink_status, as serving does (static_files.h: O_NOFOLLOW): an index.html that is a
+    // symbolic link would never be served, so it is refused here rather than answered 404 later.
     std::error_code ec;
-    if (!std::filesystem::is_regular_file(std::filesystem::path(web_root) / "index.html", ec))
-      return Status(StatusCode::kInvalidArgument, "must be a directory holding index.html: " + web_root, "--web-root");
+    const auto index = std::filesystem::symlink_status(std::filesystem::path(web_root) / "index.html", ec);
+    if (ec || !std::filesystem::is_regular_file(index))
+      return Status(StatusCode::kInvalidArgument,
+                    "must be a directory holding index.html as a regular file (not a symbolic link): " + web_root,
+                    "--web-root");
   }
   return Status::ok();
 }

@@ -3,9 +3,12 @@
 // - A name is served only if it is a plain file name: 1 to 128 characters of [A-Za-z0-9_.-],
 //   not starting with '.', so that no name can leave the root ("..", "a/b", "%2e%2e", hidden
 //   files) whatever the HTTP layer decoded; and only if it is a regular file, not a symbolic
-//   link (a link could point out of the root) nor a directory. Anything else is kNotFound.
-// - Files are read at every request (they are small; edits show at the next reload) and at most
-//   kMaxFileBytes long (kTooLarge beyond).
+//   link (a link could point out of the root) nor a directory or FIFO. Anything else, and a file
+//   that cannot be opened or read, is kNotFound (never kIo: the web routes answer 404, not 500).
+// - Files are read at every request (they are small; edits show at the next reload) through one
+//   descriptor opened with O_NOFOLLOW: its fstat decides (regular, size), so nothing can be
+//   swapped between the checks and the read. At most kMaxFileBytes are served (kTooLarge beyond,
+//   also for a file that grows while read).
 // - The content type comes from the extension (text/html, text/javascript for ES modules,
 //   text/css, ...; application/octet-stream when unknown); the ETag is strong and made of the
 //   bytes (FNV-1a 64), so it is the same across restarts and changes with the file.

@@ -2,10 +2,16 @@
 
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <future>
+
+#include "server_config.h"
 
 namespace fs = std::filesystem;
 
@@ -74,6 +80,67 @@ TEST(StaticFiles, MissingFilesAndNoRootAreNotFound) {
   ASSERT_FALSE(none.is_ok());
   EXPECT_EQ(none.status().code(), StatusCode::kNotFound);
   EXPECT_NE(none.status().message().find("--web-root"), std::string::npos);
+}
+
+TEST(StaticFiles, LinksAndFilesThatCannotBeReadAreNotFoundNot500) {
+  WebRoot w;
+  StaticFiles files(w.root.string());
+  // A link to a file inside the root is refused too (it could be re-pointed), and a dangling one.
+  fs::create_symlink(w.root / "app.js", w.root / "alias.js");
+  fs::create_symlink(w.base / "gone.txt", w.root / "dangling.txt");
+  // A FIFO: opened without blocking (no writer ever comes), then refused as not a regular file.
+  ASSERT_EQ(::mkfifo((w.root / "pipe.js").c_str(), 0644), 0);
+  for (const char* name : {"alias.js", "dangling.txt", "link.txt", "pipe.js", "sub"}) {
+    auto r = std::async(std::launch::async, [&] { return files.read(name); });
+    if (r.wait_for(std::chrono::seconds(5)) != std::future_status::ready) {
+      ::close(::open((w.root / "pipe.js").c_str(), O_WRONLY | O_NONBLOCK));  // let a blocked open return
+      FAIL() << name << ": the read blocked";
+    }
+    const auto got = r.get();
+    ASSERT_FALSE(got.is_ok()) << name;
+    EXPECT_EQ(got.status().code(), StatusCode::kNotFound) << name << ": " << got.status().to_string();
+    EXPECT_EQ(got.status().field(), "path") << name;
+  }
+  // A file without read permission (root reads it anyway: checked only for other users).
+  WebRoot::write(w.root / "secret.js", "s");
+  fs::permissions(w.root / "secret.js", fs::perms::none);
+  if (::geteuid() != 0) EXPECT_EQ(files.read("secret.js").status().code(), StatusCode::kNotFound);
+  else EXPECT_TRUE(files.read("secret.js").is_ok());
+}
+
+TEST(StaticFiles, FilesOverTheLimitAreTooLarge) {
+  WebRoot w;
+  StaticFiles files(w.root.string());
+  WebRoot::write(w.root / "big.bin", "");
+  fs::resize_file(w.root / "big.bin", StaticFiles::kMaxFileBytes + 1);  // sparse: no disk written
+  EXPECT_EQ(files.read("big.bin").status().code(), StatusCode::kTooLarge);
+  fs::resize_file(w.root / "big.bin", StaticFiles::kMaxFileBytes);
+  auto at_limit = files.read("big.bin");
+  ASSERT_TRUE(at_limit.is_ok()) << at_limit.status().to_string();
+  EXPECT_EQ(int64_t(at_limit->body.size()), StaticFiles::kMaxFileBytes);
+  WebRoot::write(w.root / "empty.txt", "");
+  auto empty = files.read("empty.txt");
+  ASSERT_TRUE(empty.is_ok());
+  EXPECT_EQ(empty->body, "");
+}
+
+TEST(StaticFiles, StartupRefusesAWebRootWhoseIndexIsALink) {
+  // ServerConfig::validate agrees with serving: an index.html that serving would refuse (a
+  // symbolic link, even to a regular file) stops the server, naming --web-root.
+  WebRoot w;
+  ServerConfig config;
+  config.web_root = w.root.string();
+  EXPECT_TRUE(config.validate().is_ok()) << config.validate().to_string();
+  fs::rename(w.root / "index.html", w.base / "index.html");
+  fs::create_symlink(w.base / "index.html", w.root / "index.html");
+  ASSERT_EQ(StaticFiles(w.root.string()).read("index.html").status().code(), StatusCode::kNotFound);
+  const Status s = config.validate();
+  EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);
+  EXPECT_EQ(s.field(), "--web-root");
+  EXPECT_NE(s.message().find("symbolic link"), std::string::npos) << s.message();
+  fs::remove(w.root / "index.html");
+  fs::create_directory(w.root / "index.html");
+  EXPECT_EQ(config.validate().field(), "--web-root");
 }
 
 TEST(StaticFiles, ContentTypesByExtension) {
