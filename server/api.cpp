@@ -353,16 +353,44 @@ HttpResponse Api::create_field(const HttpRequest& r) {
 
 HttpResponse Api::get_field(const HttpRequest& r) { return respond(200, [&] { return fields_.get(r.param("id")); }); }
 
-HttpResponse Api::delete_field(const HttpRequest& r) { return respond_status(fields_.remove(r.param("id"))); }
+namespace {
+// No `timeout` in the query: the server's --deadline (a named empty optional: GCC 12 warns
+// falsely, -Wmaybe-uninitialized, about a temporary one).
+const std::optional<std::string> kServerDeadline;
+}  // namespace
+
+HttpResponse Api::delete_field(const HttpRequest& r) {
+  // A curve being added or removed finishes first; waiting for it is bounded by --deadline (504).
+  auto removed = interruptible(r, kServerDeadline, "the delete (waiting for the field's running change)",
+                               [&](Interrupter& i) -> Result<bool> {
+                                 SOLIDTEX_RETURN_IF_ERROR(fields_.remove(r.param("id"), i));
+                                 return true;
+                               });
+  return respond_status(removed ? Status::ok() : removed.status());
+}
+
+namespace {
+
+// `revision=N` of the curve routes: the revision the client has seen (409 when the field has
+// moved on); absent: whatever is current.
+Result<std::optional<int>> expected_revision(const QueryParams& q) {
+  if (!q.has("revision")) return std::optional<int>();
+  SOLIDTEX_ASSIGN_OR_RETURN(const int64_t revision, q.get_int("revision", 0, 1, INT_MAX));
+  return std::optional<int>(int(revision));
+}
+
+}  // namespace
 
 HttpResponse Api::get_field_file(const HttpRequest& r) { return respond_bytes(fields_.file_bytes(r.param("id"))); }
 
 HttpResponse Api::add_curve(const HttpRequest& r) {
   auto result = [&]() -> Result<HttpResponse> {
-    SOLIDTEX_ASSIGN_OR_RETURN(QueryParams q, QueryParams::parse(r.query, {"timeout"}));
+    SOLIDTEX_ASSIGN_OR_RETURN(QueryParams q, QueryParams::parse(r.query, {"revision", "timeout"}));
+    SOLIDTEX_ASSIGN_OR_RETURN(const std::optional<int> revision, expected_revision(q));
     SOLIDTEX_RETURN_IF_ERROR(require_json_body(r));
-    auto updated = interruptible(r, q.get("timeout"), "the field solve",
-                                 [&](Interrupter& i) { return fields_.add_curve(r.param("id"), normalized_body(r.body), i); });
+    auto updated = interruptible(r, q.get("timeout"), "the field solve", [&](Interrupter& i) {
+      return fields_.add_curve(r.param("id"), normalized_body(r.body), i, revision);
+    });
     if (!updated) return updated.status();
     return HttpResponse::json(200, *updated);
   }();
@@ -371,9 +399,10 @@ HttpResponse Api::add_curve(const HttpRequest& r) {
 
 HttpResponse Api::remove_last_curve(const HttpRequest& r) {
   auto result = [&]() -> Result<HttpResponse> {
-    SOLIDTEX_ASSIGN_OR_RETURN(QueryParams q, QueryParams::parse(r.query, {"timeout"}));
+    SOLIDTEX_ASSIGN_OR_RETURN(QueryParams q, QueryParams::parse(r.query, {"revision", "timeout"}));
+    SOLIDTEX_ASSIGN_OR_RETURN(const std::optional<int> revision, expected_revision(q));
     auto updated = interruptible(r, q.get("timeout"), "the field solve",
-                                 [&](Interrupter& i) { return fields_.remove_last_curve(r.param("id"), i); });
+                                 [&](Interrupter& i) { return fields_.remove_last_curve(r.param("id"), i, revision); });
     if (!updated) return updated.status();
     return HttpResponse::json(200, *updated);
   }();

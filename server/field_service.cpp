@@ -3,6 +3,7 @@
 #include <chrono>
 #include <map>
 #include <mutex>
+#include <optional>
 
 #include "api_json.h"
 #include "core/json_fields.h"
@@ -35,8 +36,31 @@ struct FieldEntry {
   std::shared_ptr<const QuatGridField> field;  // the current revision, decoded
   std::unique_ptr<FieldSolver> solver;        // live solver (may be null: rebuilt on demand)
   uint64_t last_use = 0;
-  std::shared_ptr<std::mutex> busy = std::make_shared<std::mutex>();  // serialises add_curve
+  // Serialises the changes of one field (add_curve, remove_last_curve, remove); waited for in
+  // steps that poll the request's interrupter (lock_busy), never without a deadline.
+  std::shared_ptr<std::timed_mutex> busy = std::make_shared<std::timed_mutex>();
 };
+
+constexpr auto kBusyPollStep = std::chrono::milliseconds(50);
+
+// Takes `busy`, polling `interrupter` every kBusyPollStep while another change of the field
+// holds it: kCancelled (the Api answers 504 past the deadline) when it asks to stop first.
+Status lock_busy(std::timed_mutex& busy, std::unique_lock<std::timed_mutex>& lock, Interrupter& interrupter) {
+  lock = std::unique_lock<std::timed_mutex>(busy, std::defer_lock);
+  while (!lock.try_lock_for(kBusyPollStep))
+    if (interrupter.was_interrupted())
+      return Status(StatusCode::kCancelled, "cancelled while waiting for another change of the field to finish");
+  return Status::ok();
+}
+
+// 409 when the caller said which revision it expects and the field is at another one.
+Status check_revision(std::optional<int> expected, int current) {
+  if (!expected || *expected == current) return Status::ok();
+  return Status(StatusCode::kFailedPrecondition,
+                "the field is at revision " + std::to_string(current) + ", not " + std::to_string(*expected) +
+                    " (changed since); nothing was changed",
+                "revision");
+}
 
 
 }  // namespace
@@ -205,15 +229,17 @@ Result<json> FieldService::create_from_mesh(const Mesh& mesh, const MeshFieldOpt
   return info;
 }
 
-Result<json> FieldService::add_curve(const std::string& id, const std::string& curve_text, Interrupter& interrupter) {
-  std::shared_ptr<std::mutex> busy;
+Result<json> FieldService::add_curve(const std::string& id, const std::string& curve_text, Interrupter& interrupter,
+                                     std::optional<int> expected_revision) {
+  std::shared_ptr<std::timed_mutex> busy;
   {
     std::lock_guard<std::mutex> g(impl_->mutex);
     auto it = impl_->entries.find(id);
     if (it == impl_->entries.end()) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
     busy = it->second.busy;
   }
-  std::lock_guard<std::mutex> one_at_a_time(*busy);
+  std::unique_lock<std::timed_mutex> one_at_a_time;
+  SOLIDTEX_RETURN_IF_ERROR(lock_busy(*busy, one_at_a_time, interrupter));
   int revision = 0;
   std::unique_ptr<FieldSolver> solver;
   {
@@ -221,6 +247,7 @@ Result<json> FieldService::add_curve(const std::string& id, const std::string& c
     auto it = impl_->entries.find(id);
     if (it == impl_->entries.end()) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
     revision = it->second.revision;
+    SOLIDTEX_RETURN_IF_ERROR(check_revision(expected_revision, revision));
     solver = std::move(it->second.solver);
   }
   SOLIDTEX_ASSIGN_OR_RETURN(StoredField current, impl_->load_revision(id, revision));
@@ -252,21 +279,24 @@ Result<json> FieldService::add_curve(const std::string& id, const std::string& c
   return info;
 }
 
-Result<json> FieldService::remove_last_curve(const std::string& id, Interrupter& interrupter) {
-  std::shared_ptr<std::mutex> busy;
+Result<json> FieldService::remove_last_curve(const std::string& id, Interrupter& interrupter,
+                                             std::optional<int> expected_revision) {
+  std::shared_ptr<std::timed_mutex> busy;
   {
     std::lock_guard<std::mutex> g(impl_->mutex);
     auto it = impl_->entries.find(id);
     if (it == impl_->entries.end()) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
     busy = it->second.busy;
   }
-  std::lock_guard<std::mutex> one_at_a_time(*busy);
+  std::unique_lock<std::timed_mutex> one_at_a_time;
+  SOLIDTEX_RETURN_IF_ERROR(lock_busy(*busy, one_at_a_time, interrupter));
   int revision = 0;
   {
     std::lock_guard<std::mutex> g(impl_->mutex);
     auto it = impl_->entries.find(id);
     if (it == impl_->entries.end()) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
     revision = it->second.revision;
+    SOLIDTEX_RETURN_IF_ERROR(check_revision(expected_revision, revision));
   }
   const auto t0 = std::chrono::steady_clock::now();
   SOLIDTEX_ASSIGN_OR_RETURN(StoredField current, impl_->load_revision(id, revision));
@@ -286,11 +316,19 @@ Result<json> FieldService::remove_last_curve(const std::string& id, Interrupter&
   std::unique_ptr<FieldSolver> solver;
   json info;
   int restored = 0;
+  // Every earlier revision may be read: the scan polls the interrupter at each one, and a
+  // revision whose files cannot be read or decoded is passed over (an older match, or a fresh
+  // solve, serves as well).
   for (int r = revision - 1; r >= 1 && !restored; --r) {
+    if (interrupter.was_interrupted())
+      return Status(StatusCode::kCancelled, "cancelled while looking for the revision to restore");
     auto earlier = impl_->load_revision(id, r);
     if (!earlier || json::parse(earlier->sketch_json, nullptr, false) != target) continue;
-    SOLIDTEX_ASSIGN_OR_RETURN(std::string text, impl_->store.read_text(ResourceKind::kField, id, json_name(r)));
-    SOLIDTEX_ASSIGN_OR_RETURN(json earlier_info, parse_json_text(text, "field info"));
+    auto text = impl_->store.read_text(ResourceKind::kField, id, json_name(r));
+    if (!text) continue;
+    auto parsed = parse_json_text(*text, "field info");
+    if (!parsed || !parsed->is_object()) continue;
+    json earlier_info = std::move(*parsed);
     earlier_info["revision"] = revision + 1;
     earlier_info["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     SOLIDTEX_ASSIGN_OR_RETURN(info, impl_->write_revision(id, revision + 1, *earlier, std::move(earlier_info), updated));
@@ -328,7 +366,18 @@ json FieldService::list() const {
   return {{"fields", out}};
 }
 
-Status FieldService::remove(const std::string& id) {
+Status FieldService::remove(const std::string& id, Interrupter& interrupter) {
+  std::shared_ptr<std::timed_mutex> busy;
+  {
+    std::lock_guard<std::mutex> g(impl_->mutex);
+    auto it = impl_->entries.find(id);
+    if (it == impl_->entries.end()) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
+    busy = it->second.busy;
+  }
+  // A curve being added or removed finishes first (its answer stands), so that no revision is
+  // ever written into a field directory that is being deleted.
+  std::unique_lock<std::timed_mutex> one_at_a_time;
+  SOLIDTEX_RETURN_IF_ERROR(lock_busy(*busy, one_at_a_time, interrupter));
   std::lock_guard<std::mutex> g(impl_->mutex);
   auto it = impl_->entries.find(id);
   if (it == impl_->entries.end()) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "data_store.h"
@@ -44,15 +45,24 @@ class FieldService {
   Status start(std::vector<std::string>* report);
   Result<nlohmann::json> create(const std::string& sketch_json, Interrupter& interrupter);
   Result<nlohmann::json> create_from_mesh(const Mesh& mesh, const MeshFieldOptions& options, Interrupter& interrupter);
-  Result<nlohmann::json> add_curve(const std::string& id, const std::string& curve_json, Interrupter& interrupter);
+  // Changes of one field (add_curve, remove_last_curve, remove) wait for each other, polling
+  // `interrupter` every 50 ms meanwhile: kCancelled when it asks to stop before their turn.
+  // `expected_revision`, when given, must be the field's current revision, checked once it is
+  // this call's turn: else kFailedPrecondition naming "revision" (saying the current one) and
+  // nothing changes, so that a client never adds to or undoes a sketch it has not seen.
+  Result<nlohmann::json> add_curve(const std::string& id, const std::string& curve_json, Interrupter& interrupter,
+                                   std::optional<int> expected_revision = std::nullopt);
   // Undo of add_curve: the next revision holds the sketch without its last curve, equal bit for
-  // bit to the newest earlier revision with exactly those curves, or solved afresh when there is
-  // none. kFailedPrecondition when the sketch has no curve, or when its only curve would leave
-  // it with neither curves nor frames.
-  Result<nlohmann::json> remove_last_curve(const std::string& id, Interrupter& interrupter);
+  // bit to the newest earlier revision with exactly those curves (earlier revisions that cannot
+  // be read are passed over; the scan polls `interrupter`), or solved afresh when there is none.
+  // kFailedPrecondition when the sketch has no curve, or when its only curve would leave it
+  // with neither curves nor frames.
+  Result<nlohmann::json> remove_last_curve(const std::string& id, Interrupter& interrupter,
+                                           std::optional<int> expected_revision = std::nullopt);
   Result<nlohmann::json> get(const std::string& id) const;
   nlohmann::json list() const;
-  Status remove(const std::string& id);
+  // Waits for a running add_curve or remove_last_curve of the field to finish (as above).
+  Status remove(const std::string& id, Interrupter& interrupter);
   // The current revision's .stf bytes, and its number.
   Result<std::vector<uint8_t>> file_bytes(const std::string& id, int* revision = nullptr) const;
   // Frames (and scales) at min + step * (i, j, k) for i < size[0], j < size[1], k < size[2].

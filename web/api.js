@@ -68,9 +68,13 @@ export const createVolume = (spec) => callJson("POST", "/v1/volumes", { json: sp
 export const deleteVolume = (id) => callJson("DELETE", `/v1/volumes/${encodeURIComponent(id)}`);
 export const createField = (sketch) => callJson("POST", "/v1/fields", { json: sketch });
 export const deleteField = (id) => callJson("DELETE", `/v1/fields/${encodeURIComponent(id)}`);
-export const addCurve = (fieldId, curve) =>
-  callJson("POST", `/v1/fields/${encodeURIComponent(fieldId)}/curves`, { json: curve });
-export const removeLastCurve = (fieldId) => callJson("DELETE", `/v1/fields/${encodeURIComponent(fieldId)}/curves/last`);
+// `revision` (optional): the field revision the page shows; when the field has moved on (another
+// client's curve, or an undo already done) the server answers 409 (ApiError with field
+// "revision", its message saying the current revision) and changes nothing.
+export const addCurve = (fieldId, curve, revision) =>
+  callJson("POST", `/v1/fields/${encodeURIComponent(fieldId)}/curves`, { params: { revision }, json: curve });
+export const removeLastCurve = (fieldId, revision) =>
+  callJson("DELETE", `/v1/fields/${encodeURIComponent(fieldId)}/curves/last`, { params: { revision } });
 
 let deadline = null;
 

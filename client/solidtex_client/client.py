@@ -167,6 +167,15 @@ def _scale(scale: Any) -> int:
     return int(scale)
 
 
+def _revision(revision: Any) -> int:
+    """``revision`` checked as a field revision: a positive integer."""
+    if isinstance(revision, (bool, np.bool_)) or not isinstance(revision, (int, np.integer)):
+        raise TypeError(f"revision must be a positive integer, got {revision!r}")
+    if revision < 1:
+        raise ValueError(f"revision must be a positive integer, got {int(revision)}")
+    return int(revision)
+
+
 def _accept(formats: Mapping[str, str], fmt: str, what: str) -> str:
     """The Accept header for answer format ``fmt``; ``ValueError`` for a format not offered."""
     if fmt not in formats:
@@ -379,21 +388,34 @@ class Client:
         return self.request("GET", f"/v1/fields/{field_id}/file").content
 
     def add_curve(self, field_id: str, curve: Mapping[str, Any],
-                  timeout: Optional[float] = None) -> Dict[str, Any]:
-        """POST /v1/fields/{id}/curves: add one sketch curve and re-solve (revision + 1)."""
-        return self._timed("POST", f"/v1/fields/{field_id}/curves", timeout,
+                  timeout: Optional[float] = None, *,
+                  revision: Optional[int] = None) -> Dict[str, Any]:
+        """POST /v1/fields/{id}/curves: add one sketch curve and re-solve (revision + 1).
+
+        ``revision``: the revision the curve is meant for (sent only when given); when the
+        field is at another one the server changes nothing and
+        :class:`~solidtex_client.errors.Conflict` (409, ``field == "revision"``) is raised.
+        """
+        params = {} if revision is None else {"revision": _revision(revision)}
+        return self._timed("POST", f"/v1/fields/{field_id}/curves", timeout, params=params,
                            json=dict(curve)).json()
 
-    def undo_curve(self, field_id: str, timeout: Optional[float] = None) -> Dict[str, Any]:
+    def undo_curve(self, field_id: str, timeout: Optional[float] = None, *,
+                   revision: Optional[int] = None) -> Dict[str, Any]:
         """DELETE /v1/fields/{id}/curves/last: remove the sketch's last curve (revision + 1).
 
         The new revision is bit for bit the newest earlier one with the same curves, else
         solved afresh; volumes keep the revision they copied. Returns the Field. A sketch
         the removal would leave empty raises
         :class:`~solidtex_client.errors.Conflict` (409). ``timeout`` is the server-side
-        deadline in seconds.
+        deadline in seconds. ``revision`` (sent only when given): the revision whose last
+        curve is meant, e.g. the one :meth:`add_curve` returned; when the field is at another
+        one (someone else's curve is last, or a retry already undid it) nothing is removed
+        and :class:`~solidtex_client.errors.Conflict` is raised with ``field == "revision"``.
         """
-        return self._timed("DELETE", f"/v1/fields/{field_id}/curves/last", timeout).json()
+        params = {} if revision is None else {"revision": _revision(revision)}
+        return self._timed("DELETE", f"/v1/fields/{field_id}/curves/last", timeout,
+                           params=params).json()
 
     def sample_frames(self, field_id: str, min: Sequence[float], size: Sequence[int],
                       step: float = 1.0) -> Dict[str, Any]:

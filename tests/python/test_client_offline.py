@@ -269,6 +269,27 @@ def test_undo_curve_request_and_answer():
     assert info.value.field == "curves"
 
 
+def test_revision_is_sent_only_when_given():
+    fld = {"id": "fld_1", "revision": 4, "curves": 2}
+    s = FakeSession([fake_response(200, fld) for _ in range(4)])
+    c = Client("http://svc:1", session=s)
+    curve = {"points": [[0, 0, 0], [1, 0, 0]], "plane_normal": [0, 0, 1]}
+    c.add_curve("fld_1", curve)
+    c.add_curve("fld_1", curve, revision=np.int64(3), timeout=9)
+    c.undo_curve("fld_1")
+    c.undo_curve("fld_1", revision=4)
+    queries = [parse_qs(urlsplit(r.url).query) for r in s.sent]
+    assert queries == [{}, {"revision": ["3"], "timeout": ["9"]}, {}, {"revision": ["4"]}]
+    assert [r.method for r in s.sent] == ["POST", "POST", "DELETE", "DELETE"]
+    assert json.loads(s.sent[1].body) == curve, "revision is a query parameter, not a body key"
+    for bad, error in ((0, ValueError), (-1, ValueError), (True, TypeError), (2.0, TypeError), ("2", TypeError)):
+        with pytest.raises(error, match="revision must be a positive integer"):
+            c.undo_curve("fld_1", revision=bad)
+        with pytest.raises(error, match="revision must be a positive integer"):
+            c.add_curve("fld_1", curve, revision=bad)
+    assert len(s.sent) == 4
+
+
 def test_cli_slice_scale(capsys, monkeypatch, tmp_path):
     png = encode_png(np.zeros((2, 3, 3), np.uint8))
     session = FakeSession([fake_response(200, png, {"Content-Type": "image/png"})])

@@ -7,7 +7,9 @@ from __future__ import annotations
 import subprocess
 
 import numpy as np
+import pytest
 import requests
+from solidtex_client import Conflict
 
 from support import RAW, REPO, assert_error, solidtex_bin
 
@@ -62,6 +64,13 @@ def test_a_web_root_without_an_index_stops_the_server_naming_the_flag(binary, tm
     proc = subprocess.run([str(solidtex_bin()), "serve", "--port", "1", "--data", str(tmp_path / "data"),
                            "--web-root", str(empty)], capture_output=True, text=True, timeout=30)
     assert proc.returncode != 0 and "--web-root" in proc.stderr, proc.stderr
+    # an index.html that is a symbolic link would never be served (no link is): refused as well
+    linked = tmp_path / "linked"
+    linked.mkdir()
+    (linked / "index.html").symlink_to(REPO / "web" / "index.html")
+    proc = subprocess.run([str(solidtex_bin()), "serve", "--port", "1", "--data", str(tmp_path / "data"),
+                           "--web-root", str(linked)], capture_output=True, text=True, timeout=30)
+    assert proc.returncode != 0 and "--web-root" in proc.stderr and "symbolic link" in proc.stderr, proc.stderr
 
 
 def test_coarser_datasets_are_the_array_views_voxels(shared):
@@ -140,3 +149,38 @@ def test_undo_of_a_curve_never_stored_without_it_solves_afresh(shared):
     a = c.sample_frames(fid, (0, 0, 0), (4, 4, 2), step=8)["quaternions"]
     b = c.sample_frames(fresh, (0, 0, 0), (4, 4, 2), step=8)["quaternions"]
     assert np.allclose(a, b, atol=1e-6)
+
+
+def test_a_stale_revision_is_refused_by_both_curve_routes_and_changes_nothing(shared):
+    """`revision=N` on POST .../curves and DELETE .../curves/last: the change is made only when
+    the field is still at N (409 naming `revision` and saying the current one otherwise), so a
+    stale page or a retried undo never removes or builds on a curve it did not see."""
+    c, url = shared.client, shared.url
+    fid = c.create_field(SKETCH)["id"]
+    assert c.add_curve(fid, CURVE2, revision=1)["revision"] == 2
+    before, file_before = c.get_field(fid), requests.get(f"{url}/v1/fields/{fid}/file", timeout=60).content
+    curves, last = f"{url}/v1/fields/{fid}/curves", f"{url}/v1/fields/{fid}/curves/last"
+    for stale in (1, 3):
+        for response in (requests.post(curves, params={"revision": stale}, json=CURVE3, timeout=60),
+                         requests.delete(last, params={"revision": stale}, timeout=60)):
+            err = assert_error(response, 409, "failed_precondition")
+            assert err["field"] == "revision" and "revision 2" in err["message"], err
+    # the client sends it and raises the typed error
+    with pytest.raises(Conflict) as info:
+        c.undo_curve(fid, revision=1)
+    assert info.value.field == "revision"
+    with pytest.raises(Conflict):
+        c.add_curve(fid, CURVE3, revision=5)
+    assert c.get_field(fid) == before
+    assert requests.get(f"{url}/v1/fields/{fid}/file", timeout=60).content == file_before
+    for bad in ("0", "-1", "x", "1.5", ""):
+        assert_error(requests.delete(last, params={"revision": bad}, timeout=60), 400, "invalid_argument", "revision")
+        assert_error(requests.post(curves, params={"revision": bad}, json=CURVE3, timeout=60), 400, "invalid_argument",
+                     "revision")
+    # the revision shown goes through, once: a retry of the same undo is refused
+    undone = requests.delete(last, params={"revision": 2}, timeout=60)
+    assert undone.status_code == 200 and undone.json()["revision"] == 3, undone.text
+    assert_error(requests.delete(last, params={"revision": 2}, timeout=60), 409, "failed_precondition", "revision")
+    assert c.get_field(fid)["revision"] == 3
+    assert requests.get(f"{url}/v1/fields/{fid}/file", timeout=60).content != file_before
+    c.delete_field(fid)
