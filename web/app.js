@@ -4,9 +4,11 @@
 // hash (#volume=…&axis=z&…) so that a reload or a shared link shows the same cut.
 //
 // Sketching adds curves to a stored field and shows a new volume made with its new revision
-// (volumes copy their field, so the one shown before stays as it was). Undo goes back to that
-// volume, removes the curve from the field (DELETE /v1/fields/{id}/curves/last) and deletes
-// what the stroke created (its volume, and the field when the stroke started it).
+// (volumes copy their field, so the one shown before stays as it was). Undo removes the curve
+// from the field (DELETE /v1/fields/{id}/curves/last), deletes what the stroke created (its
+// volume, and the field when the stroke started it) and goes back to the volume shown before.
+// Both name the field revision the page shows (?revision=): when the field has moved on (another
+// page's curve, an undo done elsewhere) the server changes nothing and the page says why.
 
 import * as api from "./api.js";
 import { CutView, MAX_SIZE, MIN_SIZE } from "./cut_view.js";
@@ -27,7 +29,8 @@ const state = {
   view: { mode: "axis", axis: "z", center: [128, 128, 0], size: 256, yaw: 30, pitch: 20 },
   undo: [],           // {from, to, fieldId, createdField, curve} per stroke, newest last
   sketchBusy: false,
-  levels: new Map(),  // exemplar id -> pyramid levels
+  levels: new Map(),  // volume id -> datasets of its pyramid (levelsOf)
+  revisions: new Map(),  // volume id -> the revision of its stored field known to hold its curves
 };
 
 function say(text, ok = false) {
@@ -96,7 +99,6 @@ function fillSelect(select, items, keep = true) {
 
 async function refreshExemplars() {
   const exemplars = await api.listExemplars();
-  for (const e of exemplars) if (e.params && e.params.levels) state.levels.set(e.id, e.params.levels);
   fillSelect($("volume-exemplar"), exemplars.filter((e) => e.state === "ready").map((e) => [e.id, `${e.name || e.id} (${e.width}×${e.height})`]));
 }
 
@@ -135,24 +137,55 @@ const cutView = new CutView(
   },
 );
 
-async function levelsOf(volume) {
-  if (volume.label) return 1;  // region volumes serve their finest voxels only
-  const id = volume.exemplars[0];
-  if (!state.levels.has(id)) state.levels.set(id, (await api.getExemplar(id)).params.levels);
+// The datasets of volume `id`'s pyramid, the scales its cuts accept: the volume's own OME-Zarr
+// group (attributes.ome.multiscales[0].datasets: one per synthesis level; region volumes serve
+// dataset 0 only). Neither the volume's JSON (proto/openapi.json Volume) nor anything but its
+// exemplar's analysis states them, and the volume is all the page may have: it asks no exemplar.
+// Volumes never change, so the answer is kept. (Fetched here rather than in api.js, which has no
+// call for the Zarr documents.)
+async function levelsOf(id) {
+  if (!state.levels.has(id)) {
+    const response = await fetch(`/v1/volumes/${encodeURIComponent(id)}/zarr/zarr.json`);
+    let doc = null;
+    try {
+      doc = await response.json();
+    } catch (_) {
+      // not JSON: reported below
+    }
+    if (!response.ok) {
+      const e = doc && doc.error ? doc.error : { code: "http_" + response.status, message: response.statusText || "request failed", field: "" };
+      throw new api.ApiError(response.status, e.code, e.message, e.field);
+    }
+    const datasets = doc && doc.attributes && doc.attributes.ome && doc.attributes.ome.multiscales && doc.attributes.ome.multiscales[0].datasets;
+    if (!Array.isArray(datasets) || datasets.length === 0)
+      throw new api.ApiError(response.status, "bad_answer", `volume ${id}: its zarr.json lists no datasets`, "");
+    state.levels.set(id, datasets.length);
+  }
   return state.levels.get(id);
 }
 
-// Shows volume `id`; a volume chosen by hand starts a new undo history.
-async function showVolume(id, { keepUndo = false } = {}) {
-  const volume = await api.getVolume(id);
-  const levels = await levelsOf(volume);
+// Everything showing volume `id` needs from the server: its JSON and its pyramid's datasets.
+async function loadVolume(id) {
+  const [volume, levels] = await Promise.all([api.getVolume(id), levelsOf(id)]);
+  return { volume, levels };
+}
+
+// Shows a loaded volume at once (nothing here can fail) and returns its cut's render, a promise
+// settled when the finest cut is drawn or has failed; a volume chosen by hand starts a new undo
+// history.
+function presentVolume({ volume, levels }, { keepUndo = false } = {}) {
   state.volume = volume;
   if (!keepUndo) state.undo = [];
-  $("volume-select").value = id;
+  $("volume-select").value = volume.id;
   updateSketchStatus();
   writeHash();
   syncCutControls();
-  await cutView.show(id, levels, state.view);
+  return cutView.show(volume.id, levels, state.view);
+}
+
+// Shows volume `id`; settles when its finest cut is drawn.
+async function showVolume(id, options) {
+  await presentVolume(await loadVolume(id), options);
 }
 
 let renderTimer = 0;
@@ -258,13 +291,22 @@ $("volume-create").addEventListener(
 
 // ---- sketching ---------------------------------------------------------------------------
 
+// The revision of volume `v`'s stored field that a stroke on it (or the undo of the stroke that
+// made it) names: the one the volume copied, or, once an undo brought the field back to its
+// curves, the revision that undo made (the same curves, bit for bit).
+const shownRevision = (v) => (state.revisions.has(v.id) ? state.revisions.get(v.id) : v.field.revision);
+
 function updateSketchStatus() {
   const v = state.volume;
   const f = v ? v.field : null;
-  const field = !f ? "" : f.kind === "stored" ? `field ${f.id} revision ${f.revision}` : `constant field (${v.field_description})`;
-  $("sketch-status").textContent = v ? `${v.id}: ${field}` + (f && f.kind !== "stored" ? "; a curve starts a sketch field" : "") : "";
-  $("sketch-status").dataset.field = f && f.kind === "stored" ? f.id : "";
-  $("sketch-status").dataset.revision = f && f.kind === "stored" ? String(f.revision) : "";
+  const stored = f && f.kind === "stored";
+  const revision = stored ? shownRevision(v) : null;
+  const field = !f ? "" : stored
+    ? `field ${f.id} revision ${revision}` + (revision !== f.revision ? ` (the curves of revision ${f.revision}, which this volume copied)` : "")
+    : `constant field (${v.field_description})`;
+  $("sketch-status").textContent = v ? `${v.id}: ${field}` + (f && !stored ? "; a curve starts a sketch field" : "") : "";
+  $("sketch-status").dataset.field = stored ? f.id : "";
+  $("sketch-status").dataset.revision = stored ? String(revision) : "";
   $("sketch-undo").disabled = state.undo.length === 0 || state.sketchBusy;
   sketch.setStrokes(state.undo.map((u) => u.curve));
 }
@@ -279,14 +321,14 @@ async function addStroke(curve) {
     $("sketch-status").textContent = "solving the field…";
     let field, createdField = false;
     if (from.field.kind === "stored") {
-      field = await api.addCurve(from.field.id, curve);
+      field = await api.addCurve(from.field.id, curve, shownRevision(from));
     } else {
       const domain = { ...sketchDomain(state.view), shortest_side_cells: SKETCH_FIELD_CELLS };
       field = await api.createField({ domain, curves: [curve] });
       createdField = true;
     }
     const base = (from.name || from.id).replace(/ · sketch r\d+$/, "").slice(0, 150);
-    let volume;
+    let volume, levels;
     try {
       volume = await api.createVolume({
         name: `${base} · sketch r${field.revision}`,
@@ -295,35 +337,68 @@ async function addStroke(curve) {
         seed: from.seed,
         params: from.params,
       });
+      levels = await levelsOf(volume.id);
     } catch (e) {
-      // The stroke did not make a volume: take it back out of the field.
-      await (createdField ? api.deleteField(field.id) : api.removeLastCurve(field.id)).catch(() => {});
+      // The stroke made no volume the page can show: take it back out of the field (unless the
+      // field has moved on meanwhile: then the curve last is not this one).
+      if (volume) await api.deleteVolume(volume.id).catch(() => {});
+      await (createdField ? api.deleteField(field.id) : api.removeLastCurve(field.id, field.revision)).catch(() => {});
       throw e;
     }
+    // The new volume is shown (and its entry is on the undo stack) before the page takes the next
+    // stroke or undo; its cut may take a while, so they need not wait for that.
     state.undo.push({ from: from.id, to: volume.id, fieldId: field.id, createdField, curve });
+    state.revisions.set(volume.id, field.revision);
     say(`curve added: field ${field.id} revision ${field.revision} (${plural(field.curves, "curve")}, solved in ${Number(field.seconds || 0).toFixed(2)} s)`, true);
     refreshVolumes().catch(() => {});
     refreshFields().catch(() => {});
+    const drawn = presentVolume({ volume, levels }, { keepUndo: true });
+    drawn.catch(() => {});  // awaited below; never an unhandled rejection meanwhile
     state.sketchBusy = false;
-    await showVolume(volume.id, { keepUndo: true });
+    updateSketchStatus();
+    await drawn;
   } finally {
     state.sketchBusy = false;
     updateSketchStatus();
   }
 }
 
+// Undoes the newest stroke. Its entry stays on the stack, and its volume shown, until the field
+// has lost the curve: a failed request changes nothing (the page says why, and undo can be tried
+// again). The earlier volume is fetched first, so that once the field has changed nothing can
+// keep the page from showing it.
 async function undoStroke() {
-  const last = state.undo.pop();
-  if (!last || state.sketchBusy) return;
+  const last = state.undo[state.undo.length - 1];
+  if (state.sketchBusy || !last) return;
   state.sketchBusy = true;
+  updateSketchStatus();
   try {
-    const shown = showVolume(last.from, { keepUndo: true });
-    const field = last.createdField ? await api.deleteField(last.fieldId) : await api.removeLastCurve(last.fieldId);
-    await api.deleteVolume(last.to);
-    say(last.createdField ? `undone: deleted the sketch field ${last.fieldId}` : `undone: field ${field.id} revision ${field.revision} (${plural(field.curves, "curve")})`, true);
+    const earlier = await loadVolume(last.from);
+    // The stroke's volume is the one shown: the curve goes from the revision it holds.
+    const field = last.createdField
+      ? await api.deleteField(last.fieldId)
+      : await api.removeLastCurve(last.fieldId, state.revisions.get(last.to));
+    if (!last.createdField) state.revisions.set(last.from, field.revision);
+    // Undone. The stroke's volume goes too, unless it is shown outside the undo history (a volume
+    // chosen by hand meanwhile starts a new one); a failure to delete it is only reported.
+    const inHistory = state.undo.includes(last);
+    let kept = "";
+    if (inHistory || !state.volume || state.volume.id !== last.to)
+      await api.deleteVolume(last.to).then(
+        () => (state.levels.delete(last.to), state.revisions.delete(last.to)),
+        (e) => (kept = `; its volume ${last.to} was not deleted: ${e.message}`),
+      );
+    const what = last.createdField ? `deleted the sketch field ${last.fieldId}` : `field ${field.id} revision ${field.revision} (${plural(field.curves, "curve")})`;
+    say(`undone: ${what}${kept}`, !kept);
     refreshVolumes().catch(() => {});
     refreshFields().catch(() => {});
-    await shown;
+    if (!inHistory) return;
+    state.undo.splice(state.undo.lastIndexOf(last), 1);
+    const drawn = presentVolume(earlier, { keepUndo: true });
+    drawn.catch(() => {});  // awaited below; never an unhandled rejection meanwhile
+    state.sketchBusy = false;
+    updateSketchStatus();
+    await drawn;
   } finally {
     state.sketchBusy = false;
     updateSketchStatus();

@@ -1,10 +1,11 @@
 """Bake a volume's colours into a UV-atlas texture and a textured glTF (.glb).
 
 1. **Atlas**: xatlas (PyPI ``xatlas``) cuts the mesh into charts and packs them into one
-   square texture of ``atlas_size`` texels per side (default 1024), at the highest texel
-   density that fits; or at a given density, ``texels_per_voxel`` texels per finest voxel
-   along the surface (world units are voxels, so the density is independent of the mesh's
-   own units), the side then being what the packing needs. Charts are ``padding`` texels apart.
+   square texture of ``atlas_size`` texels per side (default 1024, at most 4096), at the
+   highest texel density that fits; or at a given density, ``texels_per_voxel`` texels per
+   finest voxel along the surface (world units are voxels, so the density is independent of
+   the mesh's own units), the side then being what the packing needs. Charts are ``padding``
+   texels apart.
 2. **Texels**: every texel whose centre lies in a triangle's UV image gets that centre's
    *surface point* (the triangle's barycentric weights of the centre applied to its
    mesh-coordinate corners); all of them go to the service in one ``points`` batch, each
@@ -39,7 +40,11 @@ if TYPE_CHECKING:  # pragma: no cover
     from .client import Client
 
 DEFAULT_ATLAS_SIZE = 1024
-MAX_ATLAS_SIZE = 8192
+# The largest texture side. The client's memory grows with the texel count: a bake peaked at
+# ~175 bytes per texel with ~55 % of the atlas in charts (tracemalloc, 2048² atlas: 731 MB; the
+# per-texel face, surface, linear and coverage arrays plus the baked texels' points and voxels),
+# so 4096² takes ~3 GB and 8192² would take ~12 GB: too much for the machines this runs on.
+MAX_ATLAS_SIZE = 4096
 _MIN_ATLAS_SIZE = 16
 _FIT_TRIES = 6           # packings tried to find the density that fills atlas_size
 _FILL_GUESS = 0.6        # expected share of the atlas covered by charts, for the first guess
@@ -176,9 +181,9 @@ def bake(client: "Client", volume_id: str, mesh_id: Optional[str] = None,
     Give a stored mesh's ``mesh_id`` or a ``mesh`` file (path or bytes; uploaded for the call
     and deleted after). ``placement`` as for :meth:`~solidtex_client.client.Client.surface`
     (default: resolution 512, margin 0.25). Texel density: ``atlas_size`` (texels per side of
-    the square texture, an integer in [16, 8192]; default 1024) or ``texels_per_voxel`` (texels
+    the square texture, an integer in [16, 4096]; default 1024) or ``texels_per_voxel`` (texels
     per finest voxel along the surface, > 0; the texture's side is then what the packing needs,
-    at most 8192), not both. ``padding``: texels between charts, [0, 64]; ``dilate_texels``:
+    at most 4096), not both; memory grows with the texels, ~3 GB at 4096² (``MAX_ATLAS_SIZE``). ``padding``: texels between charts, [0, 64]; ``dilate_texels``:
     rings of texels filled past chart borders, [0, 256]. ``timeout``: the ``points`` request's
     server-side deadline, seconds.
     """

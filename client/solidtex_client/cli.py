@@ -30,8 +30,10 @@ from typing import Any, Callable, List, Optional, Sequence
 import numpy as np
 import requests
 
+from .bake import MAX_ATLAS_SIZE
 from .client import Client
 from .errors import SolidtexError
+from .render import MAX_IMAGE_SIDE
 
 
 def _numbers(n: int, convert: Callable[[str], Any], noun: str):
@@ -138,7 +140,7 @@ def _parser() -> argparse.ArgumentParser:
     rd.add_argument("--azimuth", type=float, default=30.0, help="degrees (default 30)")
     rd.add_argument("--elevation", type=float, default=20.0, help="degrees (default 20)")
     rd.add_argument("--size", type=_ints(2), default=[512, 512], metavar="W,H",
-                    help="image size in pixels (default 512,512)")
+                    help=f"image size in pixels (default 512,512; at most {MAX_IMAGE_SIDE} per side)")
     rd.add_argument("--resolution", type=int,
                     help="voxels along the mesh's longest side (server default 512)")
     rd.add_argument("--margin", type=float,
@@ -156,8 +158,8 @@ def _parser() -> argparse.ArgumentParser:
     bk.add_argument("-o", "--output", required=True, help=".glb file")
     density = bk.add_mutually_exclusive_group()
     density.add_argument("--atlas-size", type=int,
-                         help="texels per side of the square texture (default 1024); the "
-                              "density is the highest that fits")
+                         help=f"texels per side of the square texture (default 1024, at most "
+                              f"{MAX_ATLAS_SIZE}); the density is the highest that fits")
     density.add_argument("--texels-per-voxel", type=float,
                          help="texel density along the surface, texels per finest voxel; the "
                               "atlas is as large as that needs")
@@ -260,6 +262,9 @@ def _render_pixels(client: Client, args: argparse.Namespace) -> None:
 
     if args.size[0] < 1 or args.size[1] < 1:
         raise ValueError(f"--size must be positive, got {args.size}")
+    if max(args.size) > MAX_IMAGE_SIDE:
+        raise ValueError(f"--size must be at most {MAX_IMAGE_SIDE} pixels per side (memory grows "
+                         f"with the pixel count, ~225 bytes per pixel), got {args.size}")
     if args.ply:
         raise ValueError("--ply writes vertex colors: it needs --colors vertex")
     out = client.render_pixels(args.volume, **_mesh_arg(args.mesh), placement=_placement(args),
@@ -291,6 +296,9 @@ def _render(client: Client, args: argparse.Namespace) -> None:
 
     if args.size[0] < 1 or args.size[1] < 1:
         raise ValueError(f"--size must be positive, got {args.size}")
+    if max(args.size) > MAX_IMAGE_SIDE:
+        raise ValueError(f"--size must be at most {MAX_IMAGE_SIDE} pixels per side (memory grows "
+                         f"with the pixel count, ~225 bytes per pixel), got {args.size}")
     where = _mesh_arg(args.mesh)
     colored = client.surface(args.volume, **where, placement=_placement(args), fmt="ply",
                              timeout=args.timeout)
@@ -344,6 +352,10 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         return 1
     except (OSError, ValueError, TimeoutError, ImportError, RuntimeError) as e:
         print(f"error: {type(e).__name__}: {e}", file=sys.stderr)
+        return 1
+    except MemoryError:
+        print("error: out of memory (a smaller --size, --atlas-size or --resolution needs less)",
+              file=sys.stderr)
         return 1
     return 0
 

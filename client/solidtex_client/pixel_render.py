@@ -23,7 +23,7 @@ import numpy as np
 
 from .mesh import MeshInput, TriangleMesh
 from .placement import Placement, placement_from
-from .render import View, face_shade
+from .render import View, face_shade, image_size
 from .srgb import encode_srgb8
 from .surface_colors import mesh_on_server, surface_colors
 
@@ -82,12 +82,13 @@ def render_pixels(client: "Client", volume_id: str, mesh_id: Optional[str] = Non
     Give a stored mesh's ``mesh_id`` or a ``mesh`` file (path or bytes; uploaded for the call
     and deleted after, see :func:`~solidtex_client.surface_colors.mesh_on_server`). ``placement``
     as for :meth:`~solidtex_client.client.Client.surface` (default: resolution 512, margin
-    0.25). View arguments as for :func:`~solidtex_client.render.render`. ``timeout``: the
-    ``points`` request's server-side deadline, seconds.
+    0.25). View arguments as for :func:`~solidtex_client.render.render`; ``size`` = (W, H) is
+    at most :data:`~solidtex_client.render.MAX_IMAGE_SIDE` (4096) per side: the render's
+    arrays take up to ~225 bytes per pixel (~4 GB at 4096², the mesh filling the view), so a
+    larger image is refused (ValueError naming ``size``) before anything is sent.
+    ``timeout``: the ``points`` request's server-side deadline, seconds.
     """
-    w, h = int(size[0]), int(size[1])
-    if w < 1 or h < 1:
-        raise ValueError(f"size must be positive, got {tuple(size)}")
+    w, h = image_size(size)
     with mesh_on_server(client, mesh_id, mesh) as (info, tri):
         place = placement_from(placement, info["bounds"])
         t0 = time.monotonic()

@@ -21,8 +21,27 @@ import numpy as np
 from .mesh import ColoredMesh
 from .raster import rasterize
 
+# The largest image side (W and H) a View, hence render and render_pixels, accepts. The client's
+# memory grows with the pixel count: render_pixels peaked at ~225 bytes per pixel with the mesh
+# filling a 2048² view (~150 with half of it covered; tracemalloc), so 4096² takes up to ~4 GB
+# and 8192² would take ~15 GB.
+MAX_IMAGE_SIDE = 4096
+
 _UP = {"y": (np.array([0.0, 1.0, 0.0]), np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0])),
        "z": (np.array([0.0, 0.0, 1.0]), np.array([0.0, -1.0, 0.0]), np.array([1.0, 0.0, 0.0]))}
+
+
+def image_size(size: Sequence[int]) -> Tuple[int, int]:
+    """``(W, H)`` of an image ``size``, each an integer in [1, :data:`MAX_IMAGE_SIDE`]; a
+    ValueError naming ``size`` otherwise."""
+    try:
+        w, h = (int(v) for v in size)
+    except (TypeError, ValueError):
+        raise ValueError(f"size must be two integers (W, H), got {size!r}") from None
+    if not (1 <= w <= MAX_IMAGE_SIDE and 1 <= h <= MAX_IMAGE_SIDE):
+        raise ValueError(f"size must be in [1, {MAX_IMAGE_SIDE}] pixels per side, got {(w, h)} "
+                         f"(memory grows with the pixel count, ~225 bytes per pixel)")
+    return w, h
 
 
 def camera_basis(azimuth: float, elevation: float, up: str = "y") -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -49,7 +68,8 @@ def camera_basis(azimuth: float, elevation: float, up: str = "y") -> Tuple[np.nd
 
 
 class View:
-    """An orthographic view of a mesh fit to a ``size`` = (W, H) image.
+    """An orthographic view of a mesh fit to a ``size`` = (W, H) image (:func:`image_size`: at
+    most :data:`MAX_IMAGE_SIDE` per side).
 
     ``right``, ``up``, ``towards`` are the camera's unit axes (:func:`camera_basis`); a mesh
     point p lands at pixel coordinates ``x = W/2 + k ((p - c).right - ox)``, ``y = H/2 -
@@ -63,9 +83,7 @@ class View:
     def __init__(self, vertices: np.ndarray, faces: np.ndarray, azimuth: float = 30.0,
                  elevation: float = 20.0, size: Sequence[int] = (512, 512), up: str = "y",
                  border: float = 0.05) -> None:
-        w, h = int(size[0]), int(size[1])
-        if w < 1 or h < 1:
-            raise ValueError(f"image size must be positive, got {tuple(size)}")
+        w, h = image_size(size)
         self.width, self.height = w, h
         self.right, self.up, self.towards = camera_basis(azimuth, elevation, up)
         verts = np.asarray(vertices, dtype=np.float64).reshape(-1, 3)

@@ -79,6 +79,28 @@ def texels_inside(uv_px, faces, width, height):
             np.concatenate(weights))
 
 
+def dilate_reference(linear, filled, rings):
+    """bake.py's dilation rule written out texel by texel, in float64: in each of ``rings``
+    rings, every texel not yet filled with a filled 8-neighbour takes the mean linear colour of
+    its filled 8-neighbours (those filled before that ring). Returns (linear, filled)."""
+    linear = np.asarray(linear, np.float64).copy()
+    filled = filled.copy()
+    h, w = filled.shape
+    for _ in range(rings):
+        ring = {}
+        for j, i in zip(*np.nonzero(~filled)):
+            near = [linear[j + dy, i + dx] for dy in (-1, 0, 1) for dx in (-1, 0, 1)
+                    if (dy or dx) and 0 <= j + dy < h and 0 <= i + dx < w and filled[j + dy, i + dx]]
+            if near:
+                ring[j, i] = np.mean(near, axis=0)
+        if not ring:
+            break
+        for (j, i), colour in ring.items():
+            linear[j, i] = colour
+            filled[j, i] = True
+    return linear, filled
+
+
 def density_of(positions, faces, uv, side, scale):
     """Texels per voxel: sqrt(texel area of the UV images / voxel area of the triangles)."""
     t = uv[faces] * side
@@ -124,19 +146,35 @@ def test_baked_texels_are_points_answers(env):
                            f"{rows[clear][bad[0]]},{cols[clear][bad[0]]}: {got[bad[0]]} vs "
                            f"{encode_srgb8(want[bad[0]])}")
     assert len(np.unique(got, axis=0)) >= 50
-    # the client baked exactly those voxels: its distinct voxels are the texels' voxels
-    assert out.stats["distinct_voxels"] >= len(np.unique(lround(world), axis=0))
-    assert out.stats["voxels_synthesized"] > 0
-    # texels next to a chart are filled (dilated), not background
+    # the client baked exactly those texels and voxels: its texels are the ones whose centres
+    # lie in a triangle's UV image, and its distinct voxels (each asked for once) are theirs
     inside = np.zeros((128, 128), bool)
     inside[rows, cols] = True
-    near = np.zeros_like(inside)
-    for dy in (-1, 0, 1):
-        for dx in (-1, 0, 1):
-            near |= np.roll(np.roll(inside, dy, 0), dx, 1)
-    assert (out.face >= 0)[inside].all()
-    ring = near & ~(out.face >= 0)
-    assert ring.any() and not (tex[ring] == 0).all(1).any()
+    assert np.array_equal(out.face >= 0, inside)
+    voxels = np.unique(lround(world), axis=0)
+    assert np.array_equal(np.unique(lround(out.placement.apply(out.surface[inside])), axis=0), voxels)
+    assert out.stats["distinct_voxels"] == len(voxels)
+    assert out.stats["voxels_synthesized"] > 0
+
+    # Dilation (default 8 rings) against the same bake without it: there every texel outside the
+    # charts is the mean colour of the baked texels; dilated, the rings around the charts follow
+    # bake.py's rule instead (each ring's texels take the mean linear colour of their filled
+    # 8-neighbours), written out here texel by texel, and only texels past them keep the mean.
+    flat = c.bake(vol, mesh_id=env.mesh["id"], placement={"resolution": RES}, atlas_size=128,
+                  dilate_texels=0)
+    assert np.array_equal(flat.face >= 0, inside)
+    assert np.array_equal(flat.texture[inside], tex[inside])
+    mean = flat.linear[inside].mean(0)      # what bake.py fills with: the baked texels' mean
+    assert np.array_equal(flat.linear[~inside], np.broadcast_to(mean, flat.linear[~inside].shape))
+    want, reached = dilate_reference(flat.linear, inside, 8)
+    ring = reached & ~inside
+    assert ring.sum() > 0.1 * (~inside).sum(), ring.sum()
+    assert np.allclose(out.linear[ring], want[ring], rtol=0, atol=1e-5)
+    assert np.array_equal(out.linear[~reached], np.broadcast_to(mean, out.linear[~reached].shape))
+    assert np.array_equal(tex, encode_srgb8(out.linear))
+    # the rings are not the mean fill: a bake whose dilation did nothing fails the checks above
+    assert (np.abs(want[ring] - mean) > 1e-3).any(1).mean() > 0.9
+    assert (tex[ring] != flat.texture[ring]).any(1).mean() > 0.9
 
 
 def test_texel_density_is_a_parameter(env):

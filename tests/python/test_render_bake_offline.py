@@ -19,6 +19,7 @@ from solidtex_client.cli import main as cli_main
 from solidtex_client.gltf import write_glb
 from solidtex_client.placement import fit_placement, lround, nearest_voxels, placement_from
 from solidtex_client.raster import coverage, rasterize
+from solidtex_client.render import MAX_IMAGE_SIDE
 from solidtex_client.srgb import encode_srgb8, srgb8_code, thresholds
 
 # -- sRGB8 --------------------------------------------------------------------------------
@@ -261,10 +262,12 @@ def test_bake_pipeline_offline():
     inside = out.face >= 0
     world = out.placement.apply(out.surface[inside])
     assert np.array_equal(out.texture[inside], encode_srgb8(voxel_color(nearest_voxels(world))))
-    # every texel whose centre lies in a triangle's UV image is baked
+    # every baked texel's centre lies in its triangle's UV image: within the triangle's u range
+    # (columns) and v range (rows)
     jj, ii = np.nonzero(inside)
     uv = out.uvs[out.indices[out.face[inside]]].astype(np.float64) * 128
     assert np.all(uv[:, :, 0].min(1) <= ii + 0.5) and np.all(uv[:, :, 0].max(1) >= ii + 0.5)
+    assert np.all(uv[:, :, 1].min(1) <= jj + 0.5) and np.all(uv[:, :, 1].max(1) >= jj + 0.5)
     assert out.stats["texels_baked"] == inside.sum()
     # at 128 texels the charts' padding takes much of the square
     assert 0.2 < out.stats["texels_baked"] / 128 ** 2 < 0.9, out.stats
@@ -329,6 +332,7 @@ def test_refused_batches_are_split_into_compact_pieces():
 
 @pytest.mark.parametrize("kwargs,word", [
     ({"atlas_size": 8}, "atlas_size"), ({"atlas_size": 10000}, "atlas_size"),
+    ({"atlas_size": bake_module.MAX_ATLAS_SIZE + 1}, "atlas_size"),
     ({"atlas_size": 64.0}, "atlas_size"), ({"texels_per_voxel": 0}, "texels_per_voxel"),
     ({"texels_per_voxel": float("nan")}, "texels_per_voxel"),
     ({"texels_per_voxel": 1e4}, "texels_per_voxel"),
@@ -340,6 +344,23 @@ def test_bake_errors_name_the_parameter(kwargs, word):
     c = Client("http://fake", session=FakeService(verts, faces))
     with pytest.raises(ValueError, match=word):
         c.bake("vol_1", mesh_id="mesh_1", placement={"resolution": 48}, **kwargs)
+
+
+def test_render_size_is_capped_before_any_request(capsys, tmp_path):
+    verts, faces = torus(8, 4)
+    fake = FakeService(verts, faces)
+    c = Client("http://fake", session=fake)
+    for size in ((MAX_IMAGE_SIDE + 1, 8), (8, 10 ** 6), (0, 8), (8,)):
+        with pytest.raises(ValueError, match=r"^size must be"):
+            c.render_pixels("vol_1", mesh_id="mesh_1", size=size)
+    assert fake.log == []
+    mesh = tmp_path / "t.obj"
+    mesh.write_bytes(obj_bytes(verts, faces))
+    for colors in ("pixel", "vertex"):
+        assert cli_main(["render", str(mesh), "--volume", "v", "-o", str(tmp_path / "x.png"),
+                         "--colors", colors, "--size", "100000,100000"]) == 1
+        err = capsys.readouterr().err
+        assert "--size must be at most 4096" in err and "Traceback" not in err, err
 
 
 def test_cli_render_and_bake_argument_errors(capsys, tmp_path):
