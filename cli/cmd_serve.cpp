@@ -3,6 +3,7 @@
 //   [--max-image-side PX] [--max-image-pixels N] [--max-voxels N] [--max-field-nodes N]
 //   [--max-jobs N] [--analysis-threads N] [--max-mesh-vertices N] [--max-mesh-faces N] [--max-request-mb M]
 //   [--volume-state-mb M] [--idle-evict-s S] [--array-extent VOXELS] [--chunk-cache-mb M] [--web-root DIR]
+//   [--job-lease-seconds S]
 #include "args.h"
 #include "commands.h"
 #include "http_server.h"
@@ -15,7 +16,7 @@ Status run_serve(const std::vector<std::string>& argv) {
              "--cache-mb", "--max-upload-mb", "--max-image-side", "--max-image-pixels", "--max-voxels",
              "--max-field-nodes", "--max-jobs", "--analysis-threads", "--max-mesh-vertices", "--max-mesh-faces",
              "--max-request-mb", "--volume-state-mb", "--idle-evict-s", "--array-extent", "--chunk-cache-mb",
-             "--web-root"},
+             "--web-root", "--job-lease-seconds"},
             {});
   SOLIDTEX_RETURN_IF_ERROR(args.parse(argv));
   if (!args.positionals().empty())
@@ -59,6 +60,7 @@ Status run_serve(const std::vector<std::string>& argv) {
   c.mesh_limits.max_faces = int64_t(mesh_faces);
   SOLIDTEX_ASSIGN_OR_RETURN(c.max_jobs, args.get_int("--max-jobs", c.max_jobs, 1, 1000));
   SOLIDTEX_ASSIGN_OR_RETURN(c.analysis_threads, args.get_int("--analysis-threads", c.analysis_threads, 1, 16));
+  SOLIDTEX_ASSIGN_OR_RETURN(c.job_lease_s, args.get_double("--job-lease-seconds", c.job_lease_s, 0.5, 3600));
   return server::run_server(c);
 }
 

@@ -1,6 +1,7 @@
 #include "data_store.h"
 
 #include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -27,6 +28,21 @@ constexpr ResourceKind kKinds[] = {ResourceKind::kExemplar, ResourceKind::kField
 
 bool is_temporary(const std::string& name) { return name.find(".tmp-") != std::string::npos; }
 
+// Seconds since the newest modification of `p` (and of the entries of a directory, one level:
+// a resource directory being written gets new files).
+double age_seconds(const fs::path& p) {
+  std::error_code ec;
+  auto newest = fs::last_write_time(p, ec);
+  if (ec) return 1e30;
+  if (fs::is_directory(p, ec))
+    for (const auto& e : fs::directory_iterator(p, ec)) {
+      std::error_code ec2;
+      const auto t = fs::last_write_time(e.path(), ec2);
+      if (!ec2 && t > newest) newest = t;
+    }
+  return std::chrono::duration<double>(fs::file_time_type::clock::now() - newest).count();
+}
+
 }  // namespace
 
 const char* acknowledging_file(ResourceKind kind) {
@@ -39,13 +55,21 @@ const char* acknowledging_file(ResourceKind kind) {
   return "";
 }
 
-Result<std::unique_ptr<DataStore>> DataStore::open(const std::string& root, std::vector<std::string>* report) {
+Result<std::unique_ptr<DataStore>> DataStore::open(const std::string& root, std::vector<std::string>* report,
+                                                   double grace_seconds) {
   std::error_code ec;
   fs::create_directories(root, ec);
   if (ec) return Status(StatusCode::kIo, "cannot create data directory '" + root + "': " + ec.message(), "--data");
   std::unique_ptr<DataStore> store(new DataStore(fs::absolute(root).string()));
   auto note = [&](const std::string& s) {
     if (report) report->push_back(s);
+  };
+  // Another replica on the same directory may be writing a young leftover right now.
+  auto old_enough = [&](const fs::path& p) {
+    if (age_seconds(p) >= grace_seconds) return true;
+    note("skipped young leftover " + p.string() + " (modified within " + std::to_string(int(grace_seconds)) +
+         " s: another replica may be writing it)");
+    return false;
   };
   for (ResourceKind kind : kKinds) {
     const fs::path dir = fs::path(store->root_) / subdir(kind);
@@ -59,12 +83,13 @@ Result<std::unique_ptr<DataStore>> DataStore::open(const std::string& root, std:
       const bool leftover = is_temporary(name) || name.rfind(".trash-", 0) == 0 || !fs::is_directory(p) ||
                             !valid_id(name) || !fs::exists(p / acknowledging_file(kind));
       if (leftover) {
+        if (!old_enough(p)) continue;
         note("removed half-written leftover " + p.string());
         fs::remove_all(p, ec);
         continue;
       }
       for (const auto& f : fs::directory_iterator(p, ec)) {
-        if (is_temporary(f.path().filename().string())) {
+        if (is_temporary(f.path().filename().string()) && old_enough(f.path())) {
           note("removed half-written leftover " + f.path().string());
           fs::remove(f.path(), ec);
         }
@@ -111,6 +136,10 @@ Result<std::string> DataStore::read_text(ResourceKind kind, const std::string& i
 bool DataStore::exists(ResourceKind kind, const std::string& id, const std::string& file) const {
   std::error_code ec;
   return valid_id(id) && fs::exists(path(kind, id, file), ec);
+}
+
+bool DataStore::acknowledged(ResourceKind kind, const std::string& id) const {
+  return exists(kind, id, acknowledging_file(kind));
 }
 
 std::vector<std::string> DataStore::files(ResourceKind kind, const std::string& id) const {

@@ -9,9 +9,12 @@
 // byte_io.h), and a resource's acknowledging file is written last, so a kill -9 at any moment
 // leaves either the whole resource or a leftover. open() removes leftovers and reports them:
 // temporaries (".*.tmp-*"), ".trash-*" directories (interrupted deletes) and resource
-// directories without their acknowledging file. Deleting renames the directory to ".trash-<id>"
-// (atomic) before removing it. Thread-safe as the file system is; callers serialise writes to
-// the same file.
+// directories without their acknowledging file. Several replicas may share one directory
+// (README, "Several replicas on one data directory"): a leftover may then be another live
+// replica's write in progress, so open() removes only leftovers whose newest modification is
+// older than kLeftoverGraceSeconds and reports the younger ones as skipped. Deleting renames
+// the directory to ".trash-<id>" (atomic) before removing it. Thread-safe as the file system
+// is; callers serialise writes to the same file.
 #pragma once
 
 #include <cstdint>
@@ -26,9 +29,15 @@ namespace solidtex::server {
 
 enum class ResourceKind { kExemplar, kField, kVolume, kMesh };
 
+// Age (newest mtime of the entry and, for a directory, of its files) below which open() leaves
+// a leftover alone: another replica may be writing it right now. Uploads and deletes finish
+// well within it.
+constexpr double kLeftoverGraceSeconds = 600;
+
 class DataStore {
  public:
-  static Result<std::unique_ptr<DataStore>> open(const std::string& root, std::vector<std::string>* report);
+  static Result<std::unique_ptr<DataStore>> open(const std::string& root, std::vector<std::string>* report,
+                                                 double grace_seconds = kLeftoverGraceSeconds);
 
   const std::string& root() const { return root_; }
   std::string path(ResourceKind kind, const std::string& id, const std::string& file = {}) const;
@@ -39,6 +48,9 @@ class DataStore {
                                     int64_t max_bytes = int64_t(1) << 32) const;
   Result<std::string> read_text(ResourceKind kind, const std::string& id, const std::string& file) const;
   bool exists(ResourceKind kind, const std::string& id, const std::string& file) const;
+  // The resource is acknowledged (its acknowledging file is present): written completely,
+  // possibly by another replica, and not deleted.
+  bool acknowledged(ResourceKind kind, const std::string& id) const;
   // Files of one resource directory, sorted.
   std::vector<std::string> files(ResourceKind kind, const std::string& id) const;
   // Ids of the resources of a kind that are acknowledged, sorted.

@@ -1,9 +1,16 @@
 #include "exemplar_service.h"
 
+#include <fcntl.h>
+#include <signal.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
+#include <iostream>
 #include <condition_variable>
 #include <deque>
+#include <filesystem>
 #include <map>
 #include <mutex>
 #include <thread>
@@ -43,7 +50,20 @@ struct Entry {
   double seconds = 0;
   std::weak_ptr<const Table> table;  // decoded, while a loaded volume holds it
   bool cancel = false;  // DELETE while running: the analysis stops, then the exemplar goes
+  // This replica holds the job's lease: the job is in `pending` or running here. An entry
+  // queued or running without it is another replica's job, watched through the store.
+  bool owned = false;
 };
+
+double wall_seconds() {
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+std::string host_name() {
+  char buf[256] = {0};
+  if (::gethostname(buf, sizeof buf - 1) != 0) return "";
+  return buf;
+}
 
 // An acknowledged analysis runs again after a restart; one that was running when the
 // process died twice (a poison pill) is marked failed instead of crash-looping the server.
@@ -62,8 +82,178 @@ struct ExemplarService::Impl {
   std::vector<std::thread> threads;
   std::atomic<bool> stopping{false};
   int running = 0;
+  // Leases (see the header): who this replica is, and the thread renewing its leases.
+  const std::string replica = DataStore::new_id("rep_");
+  const std::string host = host_name();
+  std::condition_variable renew_wake;
+  std::thread renewer;
 
   Impl(DataStore& s, const ServerConfig& c) : store(s), config(c) {}
+
+  // --- job leases (exemplars/<id>/lease) ------------------------------------------------------
+
+  std::string lease_path(const std::string& id) const { return store.path(ResourceKind::kExemplar, id, "lease"); }
+  std::string lease_text() const {
+    return json{{"owner", replica}, {"host", host}, {"pid", int64_t(::getpid())},
+                {"expires", wall_seconds() + config.job_lease_s}}
+        .dump();
+  }
+  // The lease's content; null when there is none (or it cannot be read).
+  json read_lease(const std::string& id) const {
+    auto text = store.read_text(ResourceKind::kExemplar, id, "lease");
+    if (!text) return nullptr;
+    json j = json::parse(*text, nullptr, false);
+    return j.is_discarded() ? json(json::object()) : j;  // {}: being created (O_EXCL, then written)
+  }
+  bool ours(const json& lease) const { return lease.is_object() && lease.value("owner", "") == replica; }
+  // Nobody works on the job: no lease, an expired one, or one of a process on this host that is
+  // gone (kill -9, crash: so a restart on the same directory need not wait for the expiry).
+  bool orphaned(const std::string& id) const {
+    const json lease = read_lease(id);
+    if (lease.is_null()) return true;
+    if (ours(lease)) return false;
+    if (lease.empty()) {  // created but not written yet: live while younger than a lease
+      std::error_code ec;
+      const auto t = std::filesystem::last_write_time(lease_path(id), ec);
+      return ec || std::chrono::duration<double>(std::filesystem::file_time_type::clock::now() - t).count() >
+                       config.job_lease_s;
+    }
+    const double expires = lease.value("expires", 0.0);
+    if (!(wall_seconds() < expires)) return true;
+    const int64_t pid = lease.value("pid", int64_t(0));
+    return lease.value("host", "") == host && pid > 0 && pid != ::getpid() && ::kill(pid_t(pid), 0) != 0 &&
+           errno == ESRCH;
+  }
+  // Claims the job: creates the lease (O_CREAT|O_EXCL), or replaces an orphaned one atomically
+  // (temporary file, rename). Two replicas replacing the same orphaned lease at once may both
+  // believe they won; the analysis is deterministic, so the second run only costs time.
+  bool claim(const std::string& id) {
+    const std::string path = lease_path(id);
+    const std::string text = lease_text();
+    const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+    if (fd >= 0) {
+      const bool ok = ::write(fd, text.data(), text.size()) == ssize_t(text.size()) && ::fsync(fd) == 0;
+      ::close(fd);
+      return ok;
+    }
+    if (errno != EEXIST || !orphaned(id)) return false;
+    if (!store.write_text(ResourceKind::kExemplar, id, "lease", text).is_ok()) return false;
+    return ours(read_lease(id));
+  }
+  // Extends this replica's lease; false when another replica has taken the job over.
+  bool renew(const std::string& id) {
+    if (!ours(read_lease(id))) return false;
+    return store.write_text(ResourceKind::kExemplar, id, "lease", lease_text()).is_ok();
+  }
+  void release(const std::string& id) {
+    if (ours(read_lease(id))) ::unlink(lease_path(id).c_str());
+  }
+
+  void renew_loop() {
+    const auto period = std::chrono::duration<double>(config.job_lease_s / 3);
+    std::unique_lock<std::mutex> lock(mutex);
+    while (!stopping.load()) {
+      renew_wake.wait_for(lock, period, [&] { return stopping.load(); });
+      if (stopping.load()) return;
+      for (auto& [id, e] : entries) {
+        if (!e.owned || (e.state != State::kQueued && e.state != State::kRunning)) continue;
+        if (renew(id)) continue;
+        // Taken over (this replica stalled past its lease): a queued job is left to the new
+        // owner; a running one finishes here too (the same result, written twice).
+        if (e.state == State::kQueued) {
+          pending.erase(std::remove(pending.begin(), pending.end(), id), pending.end());
+          e.owned = false;
+          e.state = State::kRunning;
+        }
+      }
+    }
+  }
+
+  // --- the store as the truth: read-through ---------------------------------------------------
+
+  // Brings the entry of `id` up to date with the store (mutex held): loads an acknowledged
+  // exemplar this replica has not seen (uploaded through another replica), drops one whose
+  // directory is gone (deleted through another replica), takes up another replica's result,
+  // and claims a job nobody works on (adopt_locked). Null: no such exemplar.
+  Entry* sync_locked(const std::string& id, std::vector<std::string>* report = nullptr) {
+    if (!DataStore::valid_id(id)) return nullptr;
+    auto it = entries.find(id);
+    const bool acknowledged = store.acknowledged(ResourceKind::kExemplar, id);
+    if (it != entries.end()) {
+      Entry& e = it->second;
+      if (!acknowledged) {  // deleted elsewhere
+        if (e.owned && e.state == State::kRunning) {  // the worker ends it, then it goes
+          e.cancel = true;
+          return nullptr;
+        }
+        pending.erase(std::remove(pending.begin(), pending.end(), id), pending.end());
+        entries.erase(it);
+        return nullptr;
+      }
+      if (!e.owned && (e.state == State::kQueued || e.state == State::kRunning)) adopt_locked(id, e, report);
+      return &e;
+    }
+    if (!acknowledged) return nullptr;
+    auto text = store.read_text(ResourceKind::kExemplar, id, "meta.json");
+    auto meta = text ? parse_json_text(*text, "meta.json") : Result<json>(text.status());
+    if (!meta) {
+      if (report) report->push_back("skipped exemplar " + id + ": " + meta.status().to_string());
+      return nullptr;
+    }
+    Entry fresh;
+    fresh.meta = *meta;
+    fresh.state = State::kRunning;
+    Entry& e = entries.emplace(id, std::move(fresh)).first->second;
+    adopt_locked(id, e, report);
+    return &e;
+  }
+
+  // An entry whose job this replica does not hold: the stored result when there is one, else
+  // the job itself when nobody works on it (orphaned), else left to its owner.
+  void adopt_locked(const std::string& id, Entry& e, std::vector<std::string>* report) {
+    auto say = [&](const std::string& line) {
+      if (report) report->push_back(line);
+      else std::cerr << "solidtex serve: " << line << "\n";
+    };
+    if (store.exists(ResourceKind::kExemplar, id, "result.json")) {
+      auto r = store.read_text(ResourceKind::kExemplar, id, "result.json");
+      auto record = r ? parse_json_text(*r, "result.json") : Result<json>(r.status());
+      if (record) {
+        apply_result(e, *record);
+      } else {
+        e.state = State::kFailed;
+        e.error = record.status();
+      }
+      return;
+    }
+    e.state = State::kRunning;  // another replica's, as far as this one knows
+    if (!orphaned(id)) return;
+    if (attempts(id) >= kMaxAnalysisAttempts) {
+      const json record{{"error", status_json(Status(StatusCode::kInternal,
+                                                     "the analysis was interrupted " + std::to_string(kMaxAnalysisAttempts) +
+                                                         " times by a server crash; it is not retried"))}};
+      (void)store.write_text(ResourceKind::kExemplar, id, "result.json", record.dump());
+      apply_result(e, record);
+      say("marked the analysis of exemplar " + id + " failed: it crashed the server before");
+      return;
+    }
+    if (!claim(id)) return;
+    e.owned = true;
+    e.state = State::kQueued;
+    e.percent = 0;
+    pending.push_back(id);
+    wake.notify_one();
+    say((report ? "re-queued the analysis of exemplar " : "took over the analysis of exemplar ") + id +
+        " (its lease was missing or had expired)");
+  }
+
+  // Every exemplar of the store, and none that is gone from it (mutex held).
+  void sync_all_locked() {
+    std::vector<std::string> ids = store.ids(ResourceKind::kExemplar);
+    for (const auto& [id, e] : entries)
+      if (!std::binary_search(ids.begin(), ids.end(), id)) ids.push_back(id);
+    for (const std::string& id : ids) sync_locked(id);
+  }
 
   // `max_bytes` > 0: the analysis cost limit, checked as the images are decoded (uploads).
   Result<ExemplarSet> build_set(const std::vector<std::pair<std::string, std::vector<uint8_t>>>& parts,
@@ -221,7 +411,7 @@ struct ExemplarService::Impl {
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (!result && stopping.load()) {  // abandoned by a clean shutdown: runs again, uncounted
       (void)store.write_text(ResourceKind::kExemplar, id, "attempts", std::to_string(attempt - 1));
-      return;
+      return;  // shutdown() releases the lease
     }
     {
       std::lock_guard<std::mutex> g(mutex);
@@ -232,8 +422,10 @@ struct ExemplarService::Impl {
     // An exemplar deleted meanwhile has no directory any more; the write then fails harmlessly.
     Status st = store.write_text(ResourceKind::kExemplar, id, "result.json", record.dump());
     std::lock_guard<std::mutex> g(mutex);
+    release(id);  // the result is there: the lease has served
     auto it = entries.find(id);
     if (it == entries.end()) return;
+    it->second.owned = false;
     apply_result(it->second, st.is_ok() ? record : json{{"error", status_json(st)}});
   }
 
@@ -298,38 +490,12 @@ ExemplarService::ExemplarService(DataStore& store, const ServerConfig& config)
 ExemplarService::~ExemplarService() { shutdown(); }
 
 Status ExemplarService::start(std::vector<std::string>* report) {
-  for (const std::string& id : impl_->store.ids(ResourceKind::kExemplar)) {
-    auto text = impl_->store.read_text(ResourceKind::kExemplar, id, "meta.json");
-    auto meta = text ? parse_json_text(*text, "meta.json") : Result<json>(text.status());
-    if (!meta) {
-      if (report) report->push_back("skipped exemplar " + id + ": " + meta.status().to_string());
-      continue;
-    }
-    Entry e;
-    e.meta = *meta;
-    if (impl_->store.exists(ResourceKind::kExemplar, id, "result.json")) {
-      auto r = impl_->store.read_text(ResourceKind::kExemplar, id, "result.json");
-      auto record = r ? parse_json_text(*r, "result.json") : Result<json>(r.status());
-      if (record) {
-        impl_->apply_result(e, *record);
-      } else {
-        e.state = State::kFailed;
-        e.error = record.status();
-      }
-    } else if (impl_->attempts(id) >= kMaxAnalysisAttempts) {
-      const json record{{"error", status_json(Status(StatusCode::kInternal,
-                                                     "the analysis was interrupted " + std::to_string(kMaxAnalysisAttempts) +
-                                                         " times by a server crash; it is not retried"))}};
-      (void)impl_->store.write_text(ResourceKind::kExemplar, id, "result.json", record.dump());
-      impl_->apply_result(e, record);
-      if (report) report->push_back("marked the analysis of exemplar " + id + " failed: it crashed the server before");
-    } else {
-      impl_->pending.push_back(id);
-      if (report) report->push_back("re-queued the analysis of exemplar " + id);
-    }
-    impl_->entries.emplace(id, std::move(e));
+  {
+    std::lock_guard<std::mutex> g(impl_->mutex);
+    for (const std::string& id : impl_->store.ids(ResourceKind::kExemplar)) impl_->sync_locked(id, report);
   }
   for (int i = 0; i < impl_->config.analysis_threads; ++i) impl_->threads.emplace_back([this] { impl_->worker(); });
+  impl_->renewer = std::thread([this] { impl_->renew_loop(); });
   return Status::ok();
 }
 
@@ -339,8 +505,17 @@ void ExemplarService::shutdown() {
     impl_->stopping = true;
   }
   impl_->wake.notify_all();
+  impl_->renew_wake.notify_all();
   for (auto& t : impl_->threads) t.join();
   impl_->threads.clear();
+  if (impl_->renewer.joinable()) impl_->renewer.join();
+  // Jobs left unfinished here go back to whichever replica looks next (or to the next start).
+  std::lock_guard<std::mutex> g(impl_->mutex);
+  for (auto& [id, e] : impl_->entries)
+    if (e.owned && (e.state == State::kQueued || e.state == State::kRunning)) {
+      impl_->release(id);
+      e.owned = false;
+    }
 }
 
 int ExemplarService::jobs_pending() const {
@@ -377,8 +552,14 @@ Result<json> ExemplarService::upload(ExemplarUpload up) {
     SOLIDTEX_RETURN_IF_ERROR(impl_->store.write(ResourceKind::kExemplar, id, name + ".img", bytes));
     parts.push_back(name);
   }
+  // The job's lease before the acknowledgement: no other replica ever sees this job unclaimed.
+  if (!impl_->claim(id)) {
+    impl_->store.remove(ResourceKind::kExemplar, id);
+    return Status(StatusCode::kIo, "cannot create the analysis lease of '" + id + "'");
+  }
   const ImageF& xy = set.plane(Plane::kXY);
   Entry e;
+  e.owned = true;
   e.meta = {{"id", id},
             {"name", up.name},
             {"params", to_json(params)},
@@ -395,7 +576,9 @@ Result<json> ExemplarService::upload(ExemplarUpload up) {
     return st;
   }
   std::lock_guard<std::mutex> g(impl_->mutex);
-  const Entry& stored = impl_->entries.emplace(id, std::move(e)).first->second;
+  // Replaces a copy a concurrent read may have loaded from the store since meta.json was written
+  // (that copy would not know this replica holds the job).
+  const Entry& stored = impl_->entries.insert_or_assign(id, std::move(e)).first->second;
   impl_->pending.push_back(id);
   impl_->wake.notify_one();
   return json{{"exemplar", impl_->exemplar_json(id, stored)}, {"job", impl_->job_json(id, stored)}};
@@ -403,13 +586,14 @@ Result<json> ExemplarService::upload(ExemplarUpload up) {
 
 Result<json> ExemplarService::get(const std::string& id) const {
   std::lock_guard<std::mutex> g(impl_->mutex);
-  auto it = impl_->entries.find(id);
-  if (it == impl_->entries.end()) return Status(StatusCode::kNotFound, "no exemplar '" + id + "'", "id");
-  return impl_->exemplar_json(id, it->second);
+  const Entry* e = impl_->sync_locked(id);
+  if (!e) return Status(StatusCode::kNotFound, "no exemplar '" + id + "'", "id");
+  return impl_->exemplar_json(id, *e);
 }
 
 json ExemplarService::list() const {
   std::lock_guard<std::mutex> g(impl_->mutex);
+  impl_->sync_all_locked();
   json out = json::array();
   for (const auto& [id, e] : impl_->entries) out.push_back(impl_->exemplar_json(id, e));
   return {{"exemplars", out}};
@@ -418,17 +602,20 @@ json ExemplarService::list() const {
 Result<json> ExemplarService::job(const std::string& job_id) const {
   std::lock_guard<std::mutex> g(impl_->mutex);
   if (job_id.rfind("job_", 0) == 0) {
-    auto it = impl_->entries.find("ex_" + job_id.substr(4));
-    if (it != impl_->entries.end()) return impl_->job_json(it->first, it->second);
+    const std::string id = "ex_" + job_id.substr(4);
+    if (const Entry* e = impl_->sync_locked(id)) return impl_->job_json(id, *e);
   }
   return Status(StatusCode::kNotFound, "no job '" + job_id + "'", "id");
 }
 
 Status ExemplarService::remove(const std::string& id, const std::function<bool(const std::string&)>& in_use) {
   std::unique_lock<std::mutex> g(impl_->mutex);
+  if (!impl_->sync_locked(id)) return Status(StatusCode::kNotFound, "no exemplar '" + id + "'", "id");
   auto it = impl_->entries.find(id);
-  if (it == impl_->entries.end()) return Status(StatusCode::kNotFound, "no exemplar '" + id + "'", "id");
-  if (it->second.state == State::kQueued) {  // never started: just drop it from the queue
+  // Another replica's job is not stopped from here: its owner notices the directory is gone
+  // (its writes fail harmlessly) and drops the exemplar at its next look.
+  if (!it->second.owned) {
+  } else if (it->second.state == State::kQueued) {  // never started: just drop it from the queue
     auto& q = impl_->pending;
     q.erase(std::remove(q.begin(), q.end(), id), q.end());
   } else if (it->second.state == State::kRunning) {  // cancel, and wait until the worker lets go
@@ -449,9 +636,9 @@ Status ExemplarService::remove(const std::string& id, const std::function<bool(c
 
 Status ExemplarService::check_ready(const std::string& id) const {
   std::lock_guard<std::mutex> g(impl_->mutex);
-  auto it = impl_->entries.find(id);
-  if (it == impl_->entries.end()) return Status(StatusCode::kNotFound, "no exemplar '" + id + "'", "exemplar");
-  if (it->second.state != State::kReady)
+  const Entry* e = impl_->sync_locked(id);
+  if (!e) return Status(StatusCode::kNotFound, "no exemplar '" + id + "'", "exemplar");
+  if (e->state != State::kReady)
     return Status(StatusCode::kFailedPrecondition, "exemplar '" + id + "' is not ready", "exemplar");
   return Status::ok();
 }
@@ -478,9 +665,9 @@ Result<std::shared_ptr<const Table>> ExemplarService::table(const std::string& i
 Result<std::vector<uint8_t>> ExemplarService::table_bytes(const std::string& id) const {
   {
     std::lock_guard<std::mutex> g(impl_->mutex);
-    auto it = impl_->entries.find(id);
-    if (it == impl_->entries.end()) return Status(StatusCode::kNotFound, "no exemplar '" + id + "'", "id");
-    if (it->second.state != State::kReady)
+    const Entry* e = impl_->sync_locked(id);
+    if (!e) return Status(StatusCode::kNotFound, "no exemplar '" + id + "'", "id");
+    if (e->state != State::kReady)
       return Status(StatusCode::kFailedPrecondition, "exemplar '" + id + "' is not ready", "id");
   }
   return impl_->store.read(ResourceKind::kExemplar, id, "table.stx");

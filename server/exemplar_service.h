@@ -8,6 +8,19 @@
 // survives restarts: start() re-queues every acknowledged exemplar without a result, and an
 // analysis interrupted by shutdown writes nothing and runs again at the next start.
 // Analysis is deterministic, so the stored table equals `solidtex analyze` on the same inputs.
+//
+// Several replicas on one data directory (README): the store is the truth. Every read (get,
+// list, job, check_ready, table) first brings its entries up to date with the store: an
+// exemplar uploaded through another replica is loaded, one deleted through another replica is
+// dropped (404), and another replica's result is taken up. A job is claimed by a lease file,
+// exemplars/<id>/lease ({"owner", "host", "pid", "expires"}: created O_CREAT|O_EXCL by the
+// uploading replica before meta.json, renewed every third of --job-lease-seconds while the job
+// is queued or running here, removed once result.json is written or at shutdown). A replica
+// that finds an exemplar without result.json whose lease is missing, expired, or held by a
+// process of the same host that no longer exists, takes the job over (atomic replace of the
+// lease) and runs it. It looks at start-up and whenever a client reads that exemplar or its job
+// (including lists); there is no background scan. Lease expiry compares wall clocks: replicas'
+// clocks must agree to well within a lease, and hosts sharing a directory need distinct names.
 // Thread-safe.
 #pragma once
 

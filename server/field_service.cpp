@@ -1,5 +1,6 @@
 #include "field_service.h"
 
+#include <algorithm>
 #include <chrono>
 #include <map>
 #include <mutex>
@@ -130,39 +131,74 @@ struct FieldService::Impl {
     SOLIDTEX_ASSIGN_OR_RETURN(auto bytes, store.read(ResourceKind::kField, id, stf_name(revision)));
     return decode_field(bytes);
   }
+
+  // The stored field's newest revision with both files (a crash between its .stf and .json
+  // leaves the previous revision current), decoded into `e`.
+  Status load_newest(const std::string& id, FieldEntry& e) const {
+    int revision = 0;
+    for (const std::string& f : store.files(ResourceKind::kField, id)) {
+      if (f.size() > 6 && f[0] == 'r' && f.ends_with(".json")) {
+        const int r = std::atoi(f.substr(1, f.size() - 6).c_str());
+        if (r > revision && store.exists(ResourceKind::kField, id, stf_name(r))) revision = r;
+      }
+    }
+    SOLIDTEX_ASSIGN_OR_RETURN(std::string text, store.read_text(ResourceKind::kField, id, json_name(revision)));
+    SOLIDTEX_ASSIGN_OR_RETURN(json info, parse_json_text(text, "field info"));
+    SOLIDTEX_ASSIGN_OR_RETURN(StoredField stored, load_revision(id, revision));
+    SOLIDTEX_ASSIGN_OR_RETURN(e.field, QuatGridField::create(stored.origin, stored.spacing, stored.dims, stored.nodes,
+                                                            stored.log_scales));
+    e.info = std::move(info);
+    e.revision = revision;
+    return Status::ok();
+  }
+
+  // Read-through (mutex held; several replicas on one data directory): loads a field created
+  // through another replica, takes up revisions another replica added (a newer r<N>.json; the
+  // live solver, of an older revision, is dropped), and drops a field deleted through another
+  // replica. Null: no such field. Changes of one field through two replicas at the same
+  // moment are not serialised across them (each serialises its own).
+  FieldEntry* sync_locked(const std::string& id, std::vector<std::string>* report = nullptr) {
+    if (!DataStore::valid_id(id)) return nullptr;
+    auto it = entries.find(id);
+    if (!store.acknowledged(ResourceKind::kField, id)) {
+      if (it != entries.end()) entries.erase(it);
+      return nullptr;
+    }
+    if (it != entries.end()) {
+      FieldEntry& e = it->second;
+      if (store.exists(ResourceKind::kField, id, json_name(e.revision + 1)) &&
+          store.exists(ResourceKind::kField, id, stf_name(e.revision + 1))) {
+        FieldEntry newer;
+        if (load_newest(id, newer).is_ok() && newer.revision > e.revision) {
+          e.field = newer.field;
+          e.info = newer.info;
+          e.revision = newer.revision;
+          e.solver.reset();
+        }
+      }
+      return &e;
+    }
+    FieldEntry e;
+    if (Status st = load_newest(id, e); !st.is_ok()) {
+      if (report) report->push_back("skipped field " + id + ": " + st.to_string());
+      return nullptr;
+    }
+    return &entries.emplace(id, std::move(e)).first->second;
+  }
+  void sync_all_locked() {
+    std::vector<std::string> ids = store.ids(ResourceKind::kField);
+    for (const auto& [id, e] : entries)
+      if (!std::binary_search(ids.begin(), ids.end(), id)) ids.push_back(id);
+    for (const std::string& id : ids) sync_locked(id);
+  }
 };
 
 FieldService::FieldService(DataStore& store, const ServerConfig& config) : impl_(std::make_unique<Impl>(store, config)) {}
 FieldService::~FieldService() = default;
 
 Status FieldService::start(std::vector<std::string>* report) {
-  for (const std::string& id : impl_->store.ids(ResourceKind::kField)) {
-    // The newest revision with both files; a crash between its .stf and .json leaves the
-    // previous revision current.
-    int revision = 0;
-    for (const std::string& f : impl_->store.files(ResourceKind::kField, id)) {
-      if (f.size() > 6 && f[0] == 'r' && f.ends_with(".json")) {
-        const int r = std::atoi(f.substr(1, f.size() - 6).c_str());
-        if (r > revision && impl_->store.exists(ResourceKind::kField, id, stf_name(r))) revision = r;
-      }
-    }
-    FieldEntry e;
-    auto text = impl_->store.read_text(ResourceKind::kField, id, json_name(revision));
-    auto info = text ? parse_json_text(*text, "field info") : Result<json>(text.status());
-    auto stored = info ? impl_->load_revision(id, revision) : Result<StoredField>(info.status());
-    if (stored) {
-      auto field = QuatGridField::create(stored->origin, stored->spacing, stored->dims, stored->nodes, stored->log_scales);
-      if (field) {
-        e.field = *field;
-        e.info = *info;
-        e.revision = revision;
-        impl_->entries.emplace(id, std::move(e));
-        continue;
-      }
-      stored = Result<StoredField>(field.status());
-    }
-    if (report) report->push_back("skipped field " + id + ": " + stored.status().to_string());
-  }
+  std::lock_guard<std::mutex> g(impl_->mutex);
+  for (const std::string& id : impl_->store.ids(ResourceKind::kField)) impl_->sync_locked(id, report);
   return Status::ok();
 }
 
@@ -234,9 +270,9 @@ Result<json> FieldService::add_curve(const std::string& id, const std::string& c
   std::shared_ptr<std::timed_mutex> busy;
   {
     std::lock_guard<std::mutex> g(impl_->mutex);
-    auto it = impl_->entries.find(id);
-    if (it == impl_->entries.end()) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
-    busy = it->second.busy;
+    FieldEntry* e = impl_->sync_locked(id);
+    if (!e) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
+    busy = e->busy;
   }
   std::unique_lock<std::timed_mutex> one_at_a_time;
   SOLIDTEX_RETURN_IF_ERROR(lock_busy(*busy, one_at_a_time, interrupter));
@@ -244,8 +280,8 @@ Result<json> FieldService::add_curve(const std::string& id, const std::string& c
   std::unique_ptr<FieldSolver> solver;
   {
     std::lock_guard<std::mutex> g(impl_->mutex);
+    if (!impl_->sync_locked(id)) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
     auto it = impl_->entries.find(id);
-    if (it == impl_->entries.end()) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
     revision = it->second.revision;
     SOLIDTEX_RETURN_IF_ERROR(check_revision(expected_revision, revision));
     solver = std::move(it->second.solver);
@@ -284,17 +320,17 @@ Result<json> FieldService::remove_last_curve(const std::string& id, Interrupter&
   std::shared_ptr<std::timed_mutex> busy;
   {
     std::lock_guard<std::mutex> g(impl_->mutex);
-    auto it = impl_->entries.find(id);
-    if (it == impl_->entries.end()) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
-    busy = it->second.busy;
+    FieldEntry* e = impl_->sync_locked(id);
+    if (!e) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
+    busy = e->busy;
   }
   std::unique_lock<std::timed_mutex> one_at_a_time;
   SOLIDTEX_RETURN_IF_ERROR(lock_busy(*busy, one_at_a_time, interrupter));
   int revision = 0;
   {
     std::lock_guard<std::mutex> g(impl_->mutex);
+    if (!impl_->sync_locked(id)) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
     auto it = impl_->entries.find(id);
-    if (it == impl_->entries.end()) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
     revision = it->second.revision;
     SOLIDTEX_RETURN_IF_ERROR(check_revision(expected_revision, revision));
   }
@@ -354,13 +390,14 @@ Result<json> FieldService::remove_last_curve(const std::string& id, Interrupter&
 
 Result<json> FieldService::get(const std::string& id) const {
   std::lock_guard<std::mutex> g(impl_->mutex);
-  auto it = impl_->entries.find(id);
-  if (it == impl_->entries.end()) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
-  return it->second.info;
+  const FieldEntry* e = impl_->sync_locked(id);
+  if (!e) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
+  return e->info;
 }
 
 json FieldService::list() const {
   std::lock_guard<std::mutex> g(impl_->mutex);
+  impl_->sync_all_locked();
   json out = json::array();
   for (const auto& [id, e] : impl_->entries) out.push_back(e.info);
   return {{"fields", out}};
@@ -370,17 +407,17 @@ Status FieldService::remove(const std::string& id, Interrupter& interrupter) {
   std::shared_ptr<std::timed_mutex> busy;
   {
     std::lock_guard<std::mutex> g(impl_->mutex);
-    auto it = impl_->entries.find(id);
-    if (it == impl_->entries.end()) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
-    busy = it->second.busy;
+    FieldEntry* e = impl_->sync_locked(id);
+    if (!e) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
+    busy = e->busy;
   }
   // A curve being added or removed finishes first (its answer stands), so that no revision is
   // ever written into a field directory that is being deleted.
   std::unique_lock<std::timed_mutex> one_at_a_time;
   SOLIDTEX_RETURN_IF_ERROR(lock_busy(*busy, one_at_a_time, interrupter));
   std::lock_guard<std::mutex> g(impl_->mutex);
+  if (!impl_->sync_locked(id)) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
   auto it = impl_->entries.find(id);
-  if (it == impl_->entries.end()) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
   SOLIDTEX_RETURN_IF_ERROR(impl_->store.remove(ResourceKind::kField, id));
   impl_->entries.erase(it);
   return Status::ok();
@@ -390,9 +427,9 @@ Result<std::vector<uint8_t>> FieldService::file_bytes(const std::string& id, int
   int r = 0;
   {
     std::lock_guard<std::mutex> g(impl_->mutex);
-    auto it = impl_->entries.find(id);
-    if (it == impl_->entries.end()) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
-    r = it->second.revision;
+    const FieldEntry* e = impl_->sync_locked(id);
+    if (!e) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
+    r = e->revision;
   }
   if (revision) *revision = r;
   return impl_->store.read(ResourceKind::kField, id, stf_name(r));
@@ -403,9 +440,9 @@ Result<json> FieldService::sample_frames(const std::string& id, const WorldPoint
   std::shared_ptr<const QuatGridField> field;
   {
     std::lock_guard<std::mutex> g(impl_->mutex);
-    auto it = impl_->entries.find(id);
-    if (it == impl_->entries.end()) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
-    field = it->second.field;
+    const FieldEntry* e = impl_->sync_locked(id);
+    if (!e) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
+    field = e->field;
   }
   int64_t count = 1;
   for (int s : size) {

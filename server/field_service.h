@@ -6,7 +6,10 @@
 // curve re-solves the stored sketch first. Solves poll the interrupter throughout (FieldSolver:
 // at every conjugate-gradient iteration), and grids beyond config.max_field_nodes are
 // refused before anything is allocated.
-// Thread-safe; operations on one field are serialised.
+// Reads go through the store (several replicas on one data directory, README): a field created
+// through another replica is loaded, a revision added through another is taken up at the next
+// access, and a field deleted through another answers 404.
+// Thread-safe; operations on one field are serialised (within one replica).
 #pragma once
 
 #include <nlohmann/json.hpp>

@@ -1,5 +1,6 @@
 #include "mesh_service.h"
 
+#include <algorithm>
 #include <map>
 #include <mutex>
 
@@ -33,21 +34,41 @@ struct MeshService::Impl {
   std::map<std::string, json> meta;
   std::map<std::string, std::shared_ptr<const Mesh>> decoded;
   Impl(DataStore& s, const ServerConfig& c) : store(s), config(c) {}
+
+  // Read-through (mutex held; several replicas on one data directory): loads a mesh stored
+  // through another replica, drops one deleted through another. False: no such mesh.
+  bool sync_locked(const std::string& id, std::vector<std::string>* report = nullptr) {
+    if (!DataStore::valid_id(id)) return false;
+    auto it = meta.find(id);
+    if (!store.acknowledged(ResourceKind::kMesh, id)) {
+      if (it != meta.end()) meta.erase(it);
+      decoded.erase(id);
+      return false;
+    }
+    if (it != meta.end()) return true;
+    auto text = store.read_text(ResourceKind::kMesh, id, "meta.json");
+    auto j = text ? parse_json_text(*text, "meta.json") : Result<json>(text.status());
+    if (!j) {
+      if (report) report->push_back("skipped mesh " + id + ": " + j.status().to_string());
+      return false;
+    }
+    meta.emplace(id, *j);
+    return true;
+  }
+  void sync_all_locked() {
+    std::vector<std::string> ids = store.ids(ResourceKind::kMesh);
+    for (const auto& [id, j] : meta)
+      if (!std::binary_search(ids.begin(), ids.end(), id)) ids.push_back(id);
+    for (const std::string& id : ids) sync_locked(id);
+  }
 };
 
 MeshService::MeshService(DataStore& store, const ServerConfig& config) : impl_(std::make_unique<Impl>(store, config)) {}
 MeshService::~MeshService() = default;
 
 Status MeshService::start(std::vector<std::string>* report) {
-  for (const std::string& id : impl_->store.ids(ResourceKind::kMesh)) {
-    auto text = impl_->store.read_text(ResourceKind::kMesh, id, "meta.json");
-    auto j = text ? parse_json_text(*text, "meta.json") : Result<json>(text.status());
-    if (!j) {
-      if (report) report->push_back("skipped mesh " + id + ": " + j.status().to_string());
-      continue;
-    }
-    impl_->meta.emplace(id, *j);
-  }
+  std::lock_guard<std::mutex> g(impl_->mutex);
+  for (const std::string& id : impl_->store.ids(ResourceKind::kMesh)) impl_->sync_locked(id, report);
   return Status::ok();
 }
 
@@ -74,13 +95,13 @@ Result<json> MeshService::upload(std::span<const uint8_t> bytes, const std::stri
 
 Result<json> MeshService::get(const std::string& id) const {
   std::lock_guard<std::mutex> g(impl_->mutex);
-  auto it = impl_->meta.find(id);
-  if (it == impl_->meta.end()) return Status(StatusCode::kNotFound, "no mesh '" + id + "'", "id");
-  return it->second;
+  if (!impl_->sync_locked(id)) return Status(StatusCode::kNotFound, "no mesh '" + id + "'", "id");
+  return impl_->meta.at(id);
 }
 
 json MeshService::list() const {
   std::lock_guard<std::mutex> g(impl_->mutex);
+  impl_->sync_all_locked();
   json out = json::array();
   for (const auto& [id, j] : impl_->meta) out.push_back(j);
   return {{"meshes", out}};
@@ -88,8 +109,8 @@ json MeshService::list() const {
 
 Status MeshService::remove(const std::string& id) {
   std::lock_guard<std::mutex> g(impl_->mutex);
+  if (!impl_->sync_locked(id)) return Status(StatusCode::kNotFound, "no mesh '" + id + "'", "id");
   auto it = impl_->meta.find(id);
-  if (it == impl_->meta.end()) return Status(StatusCode::kNotFound, "no mesh '" + id + "'", "id");
   SOLIDTEX_RETURN_IF_ERROR(impl_->store.remove(ResourceKind::kMesh, id));
   impl_->meta.erase(it);
   impl_->decoded.erase(id);
@@ -99,7 +120,7 @@ Status MeshService::remove(const std::string& id) {
 Result<std::shared_ptr<const Mesh>> MeshService::mesh(const std::string& id) {
   {
     std::lock_guard<std::mutex> g(impl_->mutex);
-    if (!impl_->meta.count(id)) return Status(StatusCode::kNotFound, "no mesh '" + id + "'", "mesh");
+    if (!impl_->sync_locked(id)) return Status(StatusCode::kNotFound, "no mesh '" + id + "'", "mesh");
     auto it = impl_->decoded.find(id);
     if (it != impl_->decoded.end()) return it->second;
   }

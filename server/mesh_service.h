@@ -1,7 +1,9 @@
 // Stored meshes: the uploaded bytes (so a stored mesh and the same bytes sent inline decode to
 // the same doubles), a summary with the defects the reader tolerated, and decoded meshes
 // cached in memory. Uploads are decoded before anything is stored, so a bad mesh stores
-// nothing. Thread-safe.
+// nothing. Reads go through the store (several replicas on one data directory, README): a mesh
+// stored through another replica is loaded, one deleted through another answers 404.
+// Thread-safe.
 #pragma once
 
 #include <nlohmann/json.hpp>

@@ -37,6 +37,7 @@ Status ServerConfig::validate() const {
   if (max_field_nodes < 8 || max_field_nodes > (int64_t(1) << 24)) return out_of_range("--max-field-nodes", "[8, 2^24]");
   if (max_jobs < 1 || max_jobs > 1000) return out_of_range("--max-jobs", "[1, 1000]");
   if (analysis_threads < 1 || analysis_threads > 16) return out_of_range("--analysis-threads", "[1, 16]");
+  if (!(job_lease_s >= 0.5 && job_lease_s <= 3600)) return out_of_range("--job-lease-seconds", "[0.5, 3600]");
   if (!web_root.empty()) {
     // symlink_status, as serving does (static_files.h: O_NOFOLLOW): an index.html that is a
     // symbolic link would never be served, so it is refused here rather than answered 404 later.

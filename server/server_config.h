@@ -37,6 +37,10 @@ struct ServerConfig {
   MeshLimits mesh_limits;           // vertex and face counts per mesh: 422 beyond
   int max_jobs = 4;                 // analysis jobs queued or running, [1, 1000]; beyond: 429
   int analysis_threads = 1;         // analyses run at once, [1, 16]
+  // An analysis job's lease (exemplars/<id>/lease, exemplar_service.h), seconds, [0.5, 3600]:
+  // renewed every third of it while this replica has the job queued or running; another
+  // replica on the same data directory takes an unfinished job over once it has expired.
+  double job_lease_s = 30;
   // Side of the chunked-array views (/zarr, /zarr2) in finest voxels from the origin, a
   // multiple of 32 in [32, 2^20]: the window on the unbounded volume those clients see.
   int64_t array_extent = 1024;

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <deque>
+#include <iostream>
 #include <map>
 #include <mutex>
 #include <string_view>
@@ -468,11 +469,49 @@ struct VolumeService::Impl {
     return out;
   }
 
-  Result<std::shared_ptr<Volume>> find(const std::string& id) const {
+  // A volume.json read back (start-up, read-through); defined below.
+  Result<std::shared_ptr<Volume>> load_stored(const std::string& id);
+
+  // The volume, read through the store (several replicas on one data directory): one created
+  // through another replica is loaded, one deleted through another is dropped (404).
+  Result<std::shared_ptr<Volume>> find(const std::string& id) {
+    auto missing = [&] { return Status(StatusCode::kNotFound, "no volume '" + id + "'", "id"); };
+    if (!DataStore::valid_id(id)) return missing();
+    const bool acknowledged = store.acknowledged(ResourceKind::kVolume, id);
+    std::shared_ptr<VolumeState> dropped;
+    {
+      std::lock_guard<std::mutex> g(mutex);
+      auto it = volumes.find(id);
+      if (acknowledged && it != volumes.end()) return it->second;
+      if (!acknowledged && it != volumes.end()) {  // deleted elsewhere
+        dropped = std::move(it->second->state);  // running queries keep theirs until they finish
+        volumes.erase(it);
+      }
+    }
+    if (dropped) {
+      dropped.reset();
+      rebalance_cache();
+    }
+    if (!acknowledged) return missing();
+    auto v = load_stored(id);
+    if (!v) {
+      std::cerr << "solidtex serve: skipped volume " << id << ": " << v.status().to_string() << "\n";
+      return missing();
+    }
     std::lock_guard<std::mutex> g(mutex);
-    auto it = volumes.find(id);
-    if (it == volumes.end()) return Status(StatusCode::kNotFound, "no volume '" + id + "'", "id");
+    auto [it, inserted] = volumes.emplace(id, *v);
+    if (inserted) touch(*it->second);
     return it->second;
+  }
+  // Every volume of the store, and none that is gone from it.
+  void sync_all() {
+    std::vector<std::string> ids = store.ids(ResourceKind::kVolume);
+    {
+      std::lock_guard<std::mutex> g(mutex);
+      for (const auto& [id, v] : volumes)
+        if (!std::binary_search(ids.begin(), ids.end(), id)) ids.push_back(id);
+    }
+    for (const std::string& id : ids) (void)find(id);
   }
 };
 
@@ -520,30 +559,30 @@ json legacy_defaults() {
 
 }  // namespace
 
+Result<std::shared_ptr<Volume>> VolumeService::Impl::load_stored(const std::string& id) {
+  SOLIDTEX_ASSIGN_OR_RETURN(std::string text, store.read_text(ResourceKind::kVolume, id, "volume.json"));
+  SOLIDTEX_ASSIGN_OR_RETURN(json info, parse_json_text(text, "volume.json"));
+  json spec = info["spec"];
+  // Volumes stored before a default was pinned keep the value they were synthesized with.
+  if (pin_params(spec, legacy_defaults())) {
+    info["spec"] = spec;
+    info["params"] = spec["params"];
+  }
+  json desc;
+  SOLIDTEX_ASSIGN_OR_RETURN(auto v, parse_spec(spec, nullptr, &desc));
+  if (info["field"].value("kind", "") == "stored") {  // checked now, loaded at the first query
+    SOLIDTEX_RETURN_IF_ERROR(load_field(store.path(ResourceKind::kVolume, id, "field.stf")).status());
+    v->inline_field = nullptr;
+  }
+  if (v->label && v->label->kind == RegionLabel::Kind::kSurfaceShell && !store.exists(ResourceKind::kVolume, id, "mesh.source"))
+    return Status(StatusCode::kCorrupt, "the volume's mesh copy is missing", "mesh.source");
+  v->info = info;
+  return v;
+}
+
 Status VolumeService::start(std::vector<std::string>* report) {
   for (const std::string& id : impl_->store.ids(ResourceKind::kVolume)) {
-    auto load = [&]() -> Result<std::shared_ptr<Volume>> {
-      SOLIDTEX_ASSIGN_OR_RETURN(std::string text, impl_->store.read_text(ResourceKind::kVolume, id, "volume.json"));
-      SOLIDTEX_ASSIGN_OR_RETURN(json info, parse_json_text(text, "volume.json"));
-      json spec = info["spec"];
-      // Volumes stored before a default was pinned keep the value they were synthesized with.
-      if (pin_params(spec, legacy_defaults())) {
-        info["spec"] = spec;
-        info["params"] = spec["params"];
-      }
-      json desc;
-      SOLIDTEX_ASSIGN_OR_RETURN(auto v, impl_->parse_spec(spec, nullptr, &desc));
-      if (info["field"].value("kind", "") == "stored") {  // checked now, loaded at the first query
-        SOLIDTEX_RETURN_IF_ERROR(load_field(impl_->store.path(ResourceKind::kVolume, id, "field.stf")).status());
-        v->inline_field = nullptr;
-      }
-      if (v->label && v->label->kind == RegionLabel::Kind::kSurfaceShell &&
-          !impl_->store.exists(ResourceKind::kVolume, id, "mesh.source"))
-        return Status(StatusCode::kCorrupt, "the volume's mesh copy is missing", "mesh.source");
-      v->info = info;
-      return v;
-    };
-    auto v = load();
+    auto v = impl_->load_stored(id);
     if (!v) {
       if (report) report->push_back("skipped volume " + id + ": " + v.status().to_string());
       continue;
@@ -619,6 +658,7 @@ Result<json> VolumeService::get(const std::string& id) const {
 }
 
 json VolumeService::list() const {
+  impl_->sync_all();
   std::lock_guard<std::mutex> g(impl_->mutex);
   json out = json::array();
   for (const auto& [id, v] : impl_->volumes) {
@@ -630,6 +670,7 @@ json VolumeService::list() const {
 }
 
 Status VolumeService::remove(const std::string& id) {
+  SOLIDTEX_RETURN_IF_ERROR(impl_->find(id).status());
   std::shared_ptr<VolumeState> dropped;
   {
     std::lock_guard<std::mutex> g(impl_->mutex);
@@ -646,6 +687,7 @@ Status VolumeService::remove(const std::string& id) {
 }
 
 bool VolumeService::uses_exemplar(const std::string& exemplar_id) const {
+  impl_->sync_all();  // volumes created through other replicas count too
   std::lock_guard<std::mutex> g(impl_->mutex);
   for (const auto& [id, v] : impl_->volumes)
     for (const auto& e : v->exemplar_ids)

@@ -14,6 +14,9 @@
 // synthesizers. Because synthesis is spatially deterministic, a query answers the same bits
 // whichever request, order, thread count, cache state or eviction computed its voxels, and the
 // same as `solidtex slice` with the same table, field, parameters and seed.
+// Reads go through the store (several replicas on one data directory, README): a volume created
+// through another replica is loaded at its first access here, one deleted through another
+// answers 404 (and its loaded state is dropped).
 // Thread-safe: queries on one volume run concurrently (the synthesizer is thread-safe).
 #pragma once
 
