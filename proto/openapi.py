@@ -153,7 +153,8 @@ S = {
      "id": {"type": "string"}, "kind": {"type": "string", "enum": ["analysis"]}, "exemplar_id": {"type": "string"},
      "state": {"type": "string", "enum": ["queued", "running", "succeeded", "failed"]},
      "percent": {"type": "number", "minimum": 0, "maximum": 100}, "seconds": {"type": "number"},
-     "error": nullable_error}},
+     "error": nullable_error},
+     "description": "With several replicas on one data directory, the replica holding the job's lease runs it; through the others the job shows as running with percent 0 until its result is stored, and one of them takes it over when the lease (--job-lease-seconds) expires."},
  "LevelReport": {"type": "object", "properties": {"level": {"type": "integer"}, "spacing": {"type": "integer"}, "mean_crossbar_error": {"type": "number"}, "random_crossbar_error": {"type": "number"}, "coherent_fraction": {"type": "number"}}},
  "Exemplar": {"type": "object", "required": ["id", "state"], "properties": {
      "id": {"type": "string"}, "name": {"type": "string"}, "state": {"type": "string", "enum": ["analyzing", "ready", "failed"]},
