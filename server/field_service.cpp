@@ -54,6 +54,13 @@ Status lock_busy(std::timed_mutex& busy, std::unique_lock<std::timed_mutex>& loc
   return Status::ok();
 }
 
+// One change of a field at a time: the entry's mutex (kept alive while held) and its lock;
+// members are destroyed in reverse order, so the lock is released before the mutex can go.
+struct FieldChangeLock {
+  std::shared_ptr<std::timed_mutex> mutex;
+  std::unique_lock<std::timed_mutex> lock;
+};
+
 // 409 when the caller said which revision it expects and the field is at another one.
 Status check_revision(std::optional<int> expected, int current) {
   if (!expected || *expected == current) return Status::ok();
@@ -185,6 +192,16 @@ struct FieldService::Impl {
     }
     return &entries.emplace(id, std::move(e)).first->second;
   }
+  // Waits (interruptibly) until no other change of field `id` runs and holds it in `out`.
+  Status lock_change(const std::string& id, FieldChangeLock& out, Interrupter& interrupter) {
+    {
+      std::lock_guard<std::mutex> g(mutex);
+      FieldEntry* e = sync_locked(id);
+      if (!e) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
+      out.mutex = e->busy;
+    }
+    return lock_busy(*out.mutex, out.lock, interrupter);
+  }
   void sync_all_locked() {
     std::vector<std::string> ids = store.ids(ResourceKind::kField);
     for (const auto& [id, e] : entries)
@@ -267,15 +284,8 @@ Result<json> FieldService::create_from_mesh(const Mesh& mesh, const MeshFieldOpt
 
 Result<json> FieldService::add_curve(const std::string& id, const std::string& curve_text, Interrupter& interrupter,
                                      std::optional<int> expected_revision) {
-  std::shared_ptr<std::timed_mutex> busy;
-  {
-    std::lock_guard<std::mutex> g(impl_->mutex);
-    FieldEntry* e = impl_->sync_locked(id);
-    if (!e) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
-    busy = e->busy;
-  }
-  std::unique_lock<std::timed_mutex> one_at_a_time;
-  SOLIDTEX_RETURN_IF_ERROR(lock_busy(*busy, one_at_a_time, interrupter));
+  FieldChangeLock one_at_a_time;
+  SOLIDTEX_RETURN_IF_ERROR(impl_->lock_change(id, one_at_a_time, interrupter));
   int revision = 0;
   std::unique_ptr<FieldSolver> solver;
   {
@@ -317,15 +327,8 @@ Result<json> FieldService::add_curve(const std::string& id, const std::string& c
 
 Result<json> FieldService::remove_last_curve(const std::string& id, Interrupter& interrupter,
                                              std::optional<int> expected_revision) {
-  std::shared_ptr<std::timed_mutex> busy;
-  {
-    std::lock_guard<std::mutex> g(impl_->mutex);
-    FieldEntry* e = impl_->sync_locked(id);
-    if (!e) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
-    busy = e->busy;
-  }
-  std::unique_lock<std::timed_mutex> one_at_a_time;
-  SOLIDTEX_RETURN_IF_ERROR(lock_busy(*busy, one_at_a_time, interrupter));
+  FieldChangeLock one_at_a_time;
+  SOLIDTEX_RETURN_IF_ERROR(impl_->lock_change(id, one_at_a_time, interrupter));
   int revision = 0;
   {
     std::lock_guard<std::mutex> g(impl_->mutex);
@@ -404,17 +407,10 @@ json FieldService::list() const {
 }
 
 Status FieldService::remove(const std::string& id, Interrupter& interrupter) {
-  std::shared_ptr<std::timed_mutex> busy;
-  {
-    std::lock_guard<std::mutex> g(impl_->mutex);
-    FieldEntry* e = impl_->sync_locked(id);
-    if (!e) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
-    busy = e->busy;
-  }
   // A curve being added or removed finishes first (its answer stands), so that no revision is
   // ever written into a field directory that is being deleted.
-  std::unique_lock<std::timed_mutex> one_at_a_time;
-  SOLIDTEX_RETURN_IF_ERROR(lock_busy(*busy, one_at_a_time, interrupter));
+  FieldChangeLock one_at_a_time;
+  SOLIDTEX_RETURN_IF_ERROR(impl_->lock_change(id, one_at_a_time, interrupter));
   std::lock_guard<std::mutex> g(impl_->mutex);
   if (!impl_->sync_locked(id)) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
   auto it = impl_->entries.find(id);
