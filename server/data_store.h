@@ -17,6 +17,8 @@
 // is; callers serialise writes to the same file.
 #pragma once
 
+#include <algorithm>
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -66,6 +68,17 @@ class DataStore {
   explicit DataStore(std::string root) : root_(std::move(root)) {}
   std::string root_;
 };
+
+// The ids a replica must look at to match the store: those stored now (sorted) followed by the
+// ones `loaded` (a map keyed by id) holds that the store no longer has (deleted elsewhere).
+template <typename LoadedMap>
+std::vector<std::string> stored_and_loaded_ids(const DataStore& store, ResourceKind kind, const LoadedMap& loaded) {
+  std::vector<std::string> ids = store.ids(kind);
+  const size_t stored = ids.size();
+  for (const auto& entry : loaded)
+    if (!std::binary_search(ids.begin(), ids.begin() + std::ptrdiff_t(stored), entry.first)) ids.push_back(entry.first);
+  return ids;
+}
 
 // The file whose presence acknowledges a resource of that kind.
 const char* acknowledging_file(ResourceKind kind);

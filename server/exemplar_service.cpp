@@ -249,10 +249,7 @@ struct ExemplarService::Impl {
 
   // Every exemplar of the store, and none that is gone from it (mutex held).
   void sync_all_locked() {
-    std::vector<std::string> ids = store.ids(ResourceKind::kExemplar);
-    for (const auto& [id, e] : entries)
-      if (!std::binary_search(ids.begin(), ids.end(), id)) ids.push_back(id);
-    for (const std::string& id : ids) sync_locked(id);
+    for (const std::string& id : stored_and_loaded_ids(store, ResourceKind::kExemplar, entries)) sync_locked(id);
   }
 
   // `max_bytes` > 0: the analysis cost limit, checked as the images are decoded (uploads).

@@ -203,10 +203,7 @@ struct FieldService::Impl {
     return lock_busy(*out.mutex, out.lock, interrupter);
   }
   void sync_all_locked() {
-    std::vector<std::string> ids = store.ids(ResourceKind::kField);
-    for (const auto& [id, e] : entries)
-      if (!std::binary_search(ids.begin(), ids.end(), id)) ids.push_back(id);
-    for (const std::string& id : ids) sync_locked(id);
+    for (const std::string& id : stored_and_loaded_ids(store, ResourceKind::kField, entries)) sync_locked(id);
   }
 };
 

@@ -56,10 +56,7 @@ struct MeshService::Impl {
     return true;
   }
   void sync_all_locked() {
-    std::vector<std::string> ids = store.ids(ResourceKind::kMesh);
-    for (const auto& [id, j] : meta)
-      if (!std::binary_search(ids.begin(), ids.end(), id)) ids.push_back(id);
-    for (const std::string& id : ids) sync_locked(id);
+    for (const std::string& id : stored_and_loaded_ids(store, ResourceKind::kMesh, meta)) sync_locked(id);
   }
 };
 
