@@ -158,22 +158,23 @@ def _rows(values: Any, width: int, dtype: Any = np.float64) -> np.ndarray:
     return np.asarray(values, dtype=np.float64).reshape(-1, width).astype(dtype, copy=False)
 
 
+def _int_at_least(name: str, value: Any, minimum: int, kind: str) -> int:
+    """``value`` checked as an integer (not a bool) >= ``minimum``; errors name ``name``."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+        raise TypeError(f"{name} must be a {kind} integer, got {value!r}")
+    if value < minimum:
+        raise ValueError(f"{name} must be a {kind} integer, got {int(value)}")
+    return int(value)
+
+
 def _scale(scale: Any) -> int:
     """``scale`` checked as a pyramid dataset index: a non-negative integer."""
-    if isinstance(scale, (bool, np.bool_)) or not isinstance(scale, (int, np.integer)):
-        raise TypeError(f"scale must be a non-negative integer, got {scale!r}")
-    if scale < 0:
-        raise ValueError(f"scale must be a non-negative integer, got {int(scale)}")
-    return int(scale)
+    return _int_at_least("scale", scale, 0, "non-negative")
 
 
 def _revision(revision: Any) -> int:
     """``revision`` checked as a field revision: a positive integer."""
-    if isinstance(revision, (bool, np.bool_)) or not isinstance(revision, (int, np.integer)):
-        raise TypeError(f"revision must be a positive integer, got {revision!r}")
-    if revision < 1:
-        raise ValueError(f"revision must be a positive integer, got {int(revision)}")
-    return int(revision)
+    return _int_at_least("revision", revision, 1, "positive")
 
 
 def _accept(formats: Mapping[str, str], fmt: str, what: str) -> str:
