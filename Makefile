@@ -38,6 +38,18 @@ bench: build
 clean:
 	rm -rf $(BUILD_DIR)
 
+# ---- Cluster (issue #16; deploy/README.md) -------------------------------------------------
+# make cluster: 3 replicas on one store behind nginx on 127.0.0.1:CLUSTER_PORT until Ctrl-C.
+# make cluster-test: tests/cluster against such a cluster (not part of make test).
+CLUSTER_PORT ?= 8090
+.PHONY: cluster cluster-test
+cluster: build
+	@scripts/cluster.sh deps
+	@CLUSTER_PORT=$(CLUSTER_PORT) scripts/cluster.sh up
+cluster-test: build python
+	@scripts/cluster.sh deps
+	@SOLIDTEX_BIN=$(abspath $(BUILD_DIR))/bin/solidtex $(BUILD_DIR)/venv/bin/python -m pytest -q -p no:cacheprovider tests/cluster
+
 # ---- Fuzzing and sanitizers -----------------------------------------------------------------
 # The fuzz tree: clang 14, every target instrumented for libFuzzer with ASan and UBSan
 # (-DSOLIDTEX_FUZZ=ON); only the harnesses of fuzz/ and the libraries they link are built.
