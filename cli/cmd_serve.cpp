@@ -3,7 +3,10 @@
 //   [--max-image-side PX] [--max-image-pixels N] [--max-voxels N] [--max-field-nodes N]
 //   [--max-jobs N] [--analysis-threads N] [--max-mesh-vertices N] [--max-mesh-faces N] [--max-request-mb M]
 //   [--volume-state-mb M] [--idle-evict-s S] [--array-extent VOXELS] [--chunk-cache-mb M] [--web-root DIR]
-//   [--job-lease-seconds S]
+//   [--job-lease-seconds S] [--storage s3://bucket/prefix --s3-endpoint URL]
+// --storage keeps the data in an S3-compatible object store instead of --data DIR; credentials
+// come from AWS_ACCESS_KEY_ID, AWS_SECRET_ACCESS_KEY, AWS_REGION (default us-east-1) and
+// AWS_SESSION_TOKEN (README, "Storage backends").
 #include "args.h"
 #include "commands.h"
 #include "http_server.h"
@@ -16,7 +19,7 @@ Status run_serve(const std::vector<std::string>& argv) {
              "--cache-mb", "--max-upload-mb", "--max-image-side", "--max-image-pixels", "--max-voxels",
              "--max-field-nodes", "--max-jobs", "--analysis-threads", "--max-mesh-vertices", "--max-mesh-faces",
              "--max-request-mb", "--volume-state-mb", "--idle-evict-s", "--array-extent", "--chunk-cache-mb",
-             "--web-root", "--job-lease-seconds"},
+             "--web-root", "--job-lease-seconds", "--storage", "--s3-endpoint"},
             {});
   SOLIDTEX_RETURN_IF_ERROR(args.parse(argv));
   if (!args.positionals().empty())
@@ -25,6 +28,10 @@ Status run_serve(const std::vector<std::string>& argv) {
   c.host = args.get("--host").value_or(c.host);
   SOLIDTEX_ASSIGN_OR_RETURN(c.port, args.get_int("--port", c.port, 1, 65535));
   c.data_dir = args.get("--data").value_or(c.data_dir);
+  c.storage = args.get("--storage").value_or(c.storage);
+  c.s3_endpoint = args.get("--s3-endpoint").value_or(c.s3_endpoint);
+  if (args.get("--storage") && args.get("--data"))
+    return Status(StatusCode::kInvalidArgument, "--data and --storage name two different stores: give one", "--storage");
   SOLIDTEX_ASSIGN_OR_RETURN(c.threads, args.get_int("--threads", c.threads, 1, 256));
   SOLIDTEX_ASSIGN_OR_RETURN(c.io_threads, args.get_int("--io-threads", c.io_threads, 1, 64));
   SOLIDTEX_ASSIGN_OR_RETURN(c.queue, args.get_int("--queue", c.queue, 0, 10000));

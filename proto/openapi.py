@@ -51,7 +51,7 @@ E = {"400": err("Malformed request: bad JSON, unknown key or query parameter, va
      "413": err("Body larger than --max-upload-mb (default 64 MiB); no other request is answered 413."),
      "415": err("Unsupported Content-Type, or an image or mesh format that is not recognised from its bytes."),
      "422": err(LIMITS_422),
-     "429": err("Too many concurrent analysis jobs (--max-jobs)."), "503": err("Worker queue full (see Retry-After) or shutting down."),
+     "429": err("Too many concurrent analysis jobs (--max-jobs)."), "503": err("Worker queue full (see Retry-After), shutting down, or the storage backend (`--storage s3://...`) cannot be reached or refuses service right now; retry later."),
      "504": err("The request's deadline passed; the work was cancelled.")}
 def errs(*codes): return {c: E[c] for c in codes}
 # Chunked-array views (server/chunked_arrays.h): every answer carries CORS headers.
@@ -107,7 +107,8 @@ image_out = {"description": "The cut. PNG (8-bit sRGB) by default; with `Accept:
     "headers": {"X-Shape": {"schema": {"type": "string"}}, "X-Dtype": {"schema": {"type": "string"}}, "X-Voxels-Synthesized": {"schema": {"type": "integer"}, "description": "Voxels this request synthesized over all levels (0 when everything was cached)."}},
     "content": {"image/png": {"schema": {"type": "string", "format": "binary"}}, "application/octet-stream": {"schema": {"type": "string", "format": "binary"}}}}
 revision_param = qp("revision", "The field revision this change is meant for (the one the client shows). When given and the field is at another revision (another client, or a retry, changed it since), the answer is 409 naming `revision` and saying the current one, and nothing changes. Absent: whatever revision is current.", integer(1, 2**31 - 1))
-REVISION_409 = "`revision` was given and the field is at another revision: nothing changed (`field` is `revision`; the message says the current revision)."
+REVISION_409 = ("`revision` was given and the field is at another revision: nothing changed (`field` is `revision`; the message says the current revision). "
+                "Also when another replica wrote the same next revision at the same moment (`field` is `revision`): nothing changed; read the field and retry.")
 scale_param = qp("scale", "Dataset s of the volume's pyramid, as /zarr's: 0 (default) the finest voxels; s > 0 synthesis level L-1-s, whose voxels are 2^s finest voxels wide (voxel i covers finest voxels [i*2^s, (i+1)*2^s)) and are that level's own colours, not filters of finer ones; nothing finer is synthesized, so coarse cuts are fast previews. Coordinates and sizes are then in that dataset's voxels. Past the volume's coarsest dataset (L-1; region volumes have dataset 0 only): 404.", integer(0, 7, default=0))
 analysis_params = [
     qp("name", "Free-form label, at most 200 characters.", {"type": "string", "maxLength": 200}),
@@ -259,19 +260,19 @@ paths = {
      "requestBody": {"required": True, "content": {"application/octet-stream": {"schema": {"type": "string", "format": "binary", "minLength": 1}}, "multipart/form-data": {"schema": {"type": "object", "required": ["xy"], "additionalProperties": False, "properties": {"xy": {"type": "string", "format": "binary"}, "yz": {"type": "string", "format": "binary"}, "zx": {"type": "string", "format": "binary"}, "mask": {"type": "string", "format": "binary"}, "mask_yz": {"type": "string", "format": "binary"}, "mask_zx": {"type": "string", "format": "binary"}}}}}},
      "responses": {"202": {"description": "Accepted; poll the job.", "headers": {"Location": {"schema": {"type": "string"}}}, "content": {"application/json": {"schema": ref("ExemplarCreated")}}, "links": exemplar_links}, **errs("400", "413", "415", "422", "429", "503")}}},
  "/v1/exemplars/{id}": {"parameters": [pid()],
-   "get": {"operationId": "get_exemplar", "summary": "One exemplar.", "responses": {"200": {**js(ref("Exemplar")), "links": {"create_volume": link("create_volume", None, "A volume of this exemplar.", {"exemplar": "$response.body#/id"})}}, **errs("404")}},
+   "get": {"operationId": "get_exemplar", "summary": "One exemplar.", "responses": {"200": {**js(ref("Exemplar")), "links": {"create_volume": link("create_volume", None, "A volume of this exemplar.", {"exemplar": "$response.body#/id"})}}, **errs("404", "503")}},
    "delete": {"operationId": "delete_exemplar", "summary": "Delete an exemplar not used by any volume.", "responses": {"204": {"description": "Deleted."}, "409": err("A volume uses it."), **errs("404", "503")}}},
  "/v1/exemplars/{id}/table": {"parameters": [pid()],
    "get": {"operationId": "get_exemplar_table", "summary": "The .stx candidate-triple table (the same bytes `solidtex analyze` writes for the same inputs).", "responses": {"200": {"description": "OK", "content": {"application/octet-stream": {"schema": {"type": "string", "format": "binary"}}}}, "409": err("Not ready."), **errs("404", "503")}}},
  "/v1/jobs/{id}": {"parameters": [pid()],
-   "get": {"operationId": "get_job", "summary": "State and progress of a background job.", "responses": {"200": js(ref("Job")), **errs("404")}}},
+   "get": {"operationId": "get_job", "summary": "State and progress of a background job.", "responses": {"200": js(ref("Job")), **errs("404", "503")}}},
  "/v1/fields": {
    "get": {"operationId": "list_fields", "summary": "List fields.", "responses": {"200": {**js({"type": "object", "properties": {"fields": {"type": "array", "items": ref("Field")}}}), "links": links_to(FIELD_OPS, "/fields/0/id", deletes=False)}, **errs("400")}},
    "post": {"operationId": "create_field", "summary": "Solve a frame field from a sketch (schema: Sketch, from proto/sketch.schema.json). Rules between fields (points inside the domain, consecutive points distinct, one normal per point, frames defined along the curve, non-zero quaternions) are checked too (400); a grid above --max-field-nodes is refused (422).", "parameters": [timeout],
      "requestBody": {"required": True, "content": {"application/json": {"schema": ref("Sketch")}}},
      "responses": {"201": created(ref("Field"), links_to(FIELD_OPS)), **errs("400", "413", "415", "422", "503", "504")}}},
  "/v1/fields/{id}": {"parameters": [pid()],
-   "get": {"operationId": "get_field", "summary": "One field.", "responses": {"200": js(ref("Field")), **errs("404")}},
+   "get": {"operationId": "get_field", "summary": "One field.", "responses": {"200": js(ref("Field")), **errs("404", "503")}},
    "delete": {"operationId": "delete_field", "summary": "Delete a field (volumes keep their own copies). A curve being added or removed finishes first; 504 when that takes past the server's --deadline (nothing deleted).", "responses": {"204": {"description": "Deleted."}, **errs("404", "503", "504")}}},
  "/v1/fields/{id}/file": {"parameters": [pid()],
    "get": {"operationId": "get_field_file", "summary": "The .stf field file of the current revision (usable with `solidtex slice --field`).", "responses": {"200": {"description": "OK", "content": {"application/octet-stream": {"schema": {"type": "string", "format": "binary"}}}}, **errs("404", "503")}}},
@@ -295,7 +296,7 @@ paths = {
      "requestBody": {"required": True, "content": {"application/json": {"schema": ref("VolumeSpec")}}},
      "responses": {"201": created(ref("Volume"), links_to(VOLUME_OPS)), "409": err("An exemplar is not ready."), **errs("400", "404", "413", "415", "422", "503")}}},
  "/v1/volumes/{id}": {"parameters": [pid()],
-   "get": {"operationId": "get_volume", "summary": "One volume.", "responses": {"200": js(ref("Volume")), **errs("404")}},
+   "get": {"operationId": "get_volume", "summary": "One volume.", "responses": {"200": js(ref("Volume")), **errs("404", "503")}},
    "delete": {"operationId": "delete_volume", "summary": "Delete a volume and drop its cache.", "responses": {"204": {"description": "Deleted."}, **errs("404", "503")}}},
  "/v1/volumes/{id}/slice": {"parameters": [pid()],
    "get": {"operationId": "slice", "summary": "Axis-aligned cut: pixel (i, j) is the voxel (u0+i, v0+j, at) of dataset `scale` (the finest voxels by default) for axis z, (at, u0+i, v0+j) for x, (u0+i, at, v0+j) for y. W*H at most --max-voxels (else 422).",
@@ -328,7 +329,7 @@ paths = {
                                                 "field_from_mesh": link("field_from_mesh", None, "A curvature field of this mesh.", {"mesh": "$response.body#/id", "kind": "curvature"})}),
                    **errs("400", "413", "415", "422", "503")}}},
  "/v1/meshes/{id}": {"parameters": [pid()],
-   "get": {"operationId": "get_mesh", "summary": "One mesh (summary and defects).", "responses": {"200": js(ref("Mesh")), **errs("404")}},
+   "get": {"operationId": "get_mesh", "summary": "One mesh (summary and defects).", "responses": {"200": js(ref("Mesh")), **errs("404", "503")}},
    "delete": {"operationId": "delete_mesh", "summary": "Delete a mesh.", "responses": {"204": {"description": "Deleted."}, **errs("404", "503")}}},
  "/v1/meshes/{id}/file": {"parameters": [pid()],
    "get": {"operationId": "get_mesh_file", "summary": "The mesh as stored: binary little-endian PLY of the cleaned triangles (positions in mesh coordinates).", "responses": {"200": {"description": "OK", "content": {"application/octet-stream": {"schema": {"type": "string", "format": "binary"}}}}, **errs("404", "503")}}},

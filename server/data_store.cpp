@@ -1,10 +1,17 @@
 #include "data_store.h"
 
+#include <fcntl.h>
+#include <sys/file.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <atomic>
+#include <cerrno>
 #include <chrono>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <random>
 
 #include "core/byte_io.h"
 #include "core/image_io.h"
@@ -13,16 +20,6 @@ namespace fs = std::filesystem;
 
 namespace solidtex::server {
 namespace {
-
-const char* subdir(ResourceKind kind) {
-  switch (kind) {
-    case ResourceKind::kExemplar: return "exemplars";
-    case ResourceKind::kField: return "fields";
-    case ResourceKind::kVolume: return "volumes";
-    case ResourceKind::kMesh: return "meshes";
-  }
-  return "unknown";
-}
 
 constexpr ResourceKind kKinds[] = {ResourceKind::kExemplar, ResourceKind::kField, ResourceKind::kVolume, ResourceKind::kMesh};
 
@@ -45,16 +42,6 @@ double age_seconds(const fs::path& p) {
 
 }  // namespace
 
-const char* acknowledging_file(ResourceKind kind) {
-  switch (kind) {
-    case ResourceKind::kExemplar: return "meta.json";
-    case ResourceKind::kField: return "r1.json";
-    case ResourceKind::kVolume: return "volume.json";
-    case ResourceKind::kMesh: return "meta.json";
-  }
-  return "";
-}
-
 Result<std::unique_ptr<DataStore>> DataStore::open(const std::string& root, std::vector<std::string>* report,
                                                    double grace_seconds) {
   std::error_code ec;
@@ -72,7 +59,7 @@ Result<std::unique_ptr<DataStore>> DataStore::open(const std::string& root, std:
     return false;
   };
   for (ResourceKind kind : kKinds) {
-    const fs::path dir = fs::path(store->root_) / subdir(kind);
+    const fs::path dir = fs::path(store->root_) / kind_dir(kind);
     fs::create_directories(dir, ec);
     if (ec) return Status(StatusCode::kIo, "cannot create '" + dir.string() + "': " + ec.message(), "--data");
     std::vector<fs::path> entries;
@@ -100,7 +87,7 @@ Result<std::unique_ptr<DataStore>> DataStore::open(const std::string& root, std:
 }
 
 std::string DataStore::path(ResourceKind kind, const std::string& id, const std::string& file) const {
-  fs::path p = fs::path(root_) / subdir(kind) / id;
+  fs::path p = fs::path(root_) / kind_dir(kind) / id;
   if (!file.empty()) p /= file;
   return p.string();
 }
@@ -115,35 +102,210 @@ Status DataStore::create(ResourceKind kind, const std::string& id) {
 
 Status DataStore::write(ResourceKind kind, const std::string& id, const std::string& file,
                         std::span<const uint8_t> bytes) {
+  if (!valid_id(id)) return Status(StatusCode::kInvalidArgument, "malformed id '" + id + "'", "id");
   return write_file_atomic(path(kind, id, file), bytes);
 }
 
-Status DataStore::write_text(ResourceKind kind, const std::string& id, const std::string& file,
-                             const std::string& text) {
-  return write(kind, id, file, std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(text.data()), text.size()));
+namespace {
+
+Status errno_status(const std::string& what, const std::string& path) {
+  return Status(StatusCode::kIo, what + " '" + path + "': " + std::strerror(errno));
+}
+
+// A complete, fsync'd temporary file beside `target` with a name no other writer uses (the
+// pid alone is not enough: two threads of this process may race for one object).
+Result<std::string> write_temporary(const std::string& target, std::span<const uint8_t> bytes) {
+  static std::atomic<uint64_t> counter{0};
+  const fs::path t(target);
+  std::string name = ".";  // built by appending: GCC 12 warns falsely (-Wrestrict) about "." + std::string
+  name += t.filename().string();
+  name += ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter.fetch_add(1));
+  const std::string tmp = (t.parent_path() / name).string();
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+  if (fd < 0) return errno_status("cannot create", tmp);
+  size_t off = 0;
+  while (off < bytes.size()) {
+    const ssize_t n = ::write(fd, bytes.data() + off, bytes.size() - off);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) {
+      Status st = errno_status("cannot write", tmp);
+      ::close(fd);
+      ::unlink(tmp.c_str());
+      return st;
+    }
+    off += size_t(n);
+  }
+  if (::fsync(fd) != 0 || ::close(fd) != 0) {
+    ::unlink(tmp.c_str());
+    return Status(StatusCode::kIo, "cannot sync '" + tmp + "'");
+  }
+  return tmp;
+}
+
+void sync_directory(const std::string& file) {
+  const int dfd = ::open(fs::path(file).parent_path().c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dfd >= 0) {
+    ::fsync(dfd);
+    ::close(dfd);
+  }
+}
+
+Result<std::vector<uint8_t>> read_fd(int fd, const std::string& path, int64_t max_bytes) {
+  struct stat st {};
+  if (::fstat(fd, &st) != 0) return errno_status("cannot stat", path);
+  if (st.st_size > max_bytes)
+    return Status(StatusCode::kTooLarge, "'" + path + "' has " + std::to_string(st.st_size) + " bytes, more than " +
+                                             std::to_string(max_bytes));
+  std::vector<uint8_t> out(size_t(st.st_size));
+  size_t off = 0;
+  while (off < out.size()) {
+    const ssize_t n = ::pread(fd, out.data() + off, out.size() - off, off_t(off));
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) return errno_status("cannot read", path);
+    if (n == 0) break;
+    off += size_t(n);
+  }
+  out.resize(off);
+  return out;
+}
+
+// The current file at `path`, opened and exclusively flock()ed, verified to still be the one
+// the name refers to (a replace renames a new file over the name; a remove unlinks it).
+// Closing the descriptor releases the lock. kNotFound when there is no file.
+class LockedFile {
+ public:
+  ~LockedFile() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  Status lock(const std::string& path) {
+    for (;;) {
+      fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+      if (fd_ < 0) {
+        if (errno == ENOENT) return Status(StatusCode::kNotFound, "no file '" + path + "'");
+        return errno_status("cannot open", path);
+      }
+      while (::flock(fd_, LOCK_EX) != 0)
+        if (errno != EINTR) return errno_status("cannot lock", path);
+      struct stat held {}, named {};
+      if (::fstat(fd_, &held) != 0) return errno_status("cannot stat", path);
+      if (::stat(path.c_str(), &named) == 0 && named.st_ino == held.st_ino && named.st_dev == held.st_dev)
+        return Status::ok();
+      ::close(fd_);  // replaced or removed while we waited: look again
+      fd_ = -1;
+    }
+  }
+  int fd() const { return fd_; }
+
+ private:
+  int fd_ = -1;
+};
+
+Status etag_mismatch(const std::string& path) {
+  return Status(StatusCode::kFailedPrecondition, "'" + path + "' was changed by another writer");
+}
+
+}  // namespace
+
+std::string DataStore::etag_of(std::span<const uint8_t> bytes) {
+  uint64_t h = 1469598103934665603ull;  // FNV-1a
+  for (uint8_t b : bytes) h = (h ^ b) * 1099511628211ull;
+  static const char* hex = "0123456789abcdef";
+  std::string out(16, '0');
+  for (int i = 0; i < 16; ++i) out[size_t(i)] = hex[(h >> (4 * (15 - i))) & 15];
+  return out;
+}
+
+Result<std::string> DataStore::create_new(ResourceKind kind, const std::string& id, const std::string& file,
+                                          std::span<const uint8_t> bytes) {
+  if (!valid_id(id)) return Status(StatusCode::kInvalidArgument, "malformed id '" + id + "'", "id");
+  const std::string target = path(kind, id, file);
+  SOLIDTEX_ASSIGN_OR_RETURN(std::string tmp, write_temporary(target, bytes));
+  // link() never replaces: the name appears with its whole content, or not at all.
+  const int rc = ::link(tmp.c_str(), target.c_str());
+  const int err = errno;
+  ::unlink(tmp.c_str());
+  if (rc != 0) {
+    if (err == EEXIST) return Status(StatusCode::kAlreadyExists, "'" + target + "' exists");
+    errno = err;
+    return errno_status("cannot create", target);
+  }
+  sync_directory(target);
+  return etag_of(bytes);
+}
+
+Result<std::string> DataStore::replace_if_match(ResourceKind kind, const std::string& id, const std::string& file,
+                                                std::span<const uint8_t> bytes, const std::string& etag) {
+  if (!valid_id(id)) return Status(StatusCode::kInvalidArgument, "malformed id '" + id + "'", "id");
+  const std::string target = path(kind, id, file);
+  LockedFile current;
+  if (Status st = current.lock(target); !st.is_ok())
+    return st.code() == StatusCode::kNotFound ? etag_mismatch(target) : st;
+  SOLIDTEX_ASSIGN_OR_RETURN(auto old, read_fd(current.fd(), target, int64_t(1) << 32));
+  if (etag_of(old) != etag) return etag_mismatch(target);
+  SOLIDTEX_ASSIGN_OR_RETURN(std::string tmp, write_temporary(target, bytes));
+  if (::rename(tmp.c_str(), target.c_str()) != 0) {
+    Status st = errno_status("cannot replace", target);
+    ::unlink(tmp.c_str());
+    return st;
+  }
+  sync_directory(target);
+  return etag_of(bytes);
+}
+
+Status DataStore::remove_if_match(ResourceKind kind, const std::string& id, const std::string& file,
+                                  const std::string& etag) {
+  if (!valid_id(id)) return Status(StatusCode::kNotFound, "no such resource '" + id + "'", "id");
+  const std::string target = path(kind, id, file);
+  LockedFile current;
+  SOLIDTEX_RETURN_IF_ERROR(current.lock(target));
+  SOLIDTEX_ASSIGN_OR_RETURN(auto old, read_fd(current.fd(), target, int64_t(1) << 32));
+  if (etag_of(old) != etag) return etag_mismatch(target);
+  if (::unlink(target.c_str()) != 0) return errno_status("cannot remove", target);
+  sync_directory(target);
+  return Status::ok();
 }
 
 Result<std::vector<uint8_t>> DataStore::read(ResourceKind kind, const std::string& id, const std::string& file,
                                              int64_t max_bytes) const {
+  if (!valid_id(id)) return Status(StatusCode::kNotFound, "no such resource '" + id + "'", "id");
   return read_file_bytes(path(kind, id, file), max_bytes);
 }
 
-Result<std::string> DataStore::read_text(ResourceKind kind, const std::string& id, const std::string& file) const {
-  SOLIDTEX_ASSIGN_OR_RETURN(auto bytes, read(kind, id, file, int64_t(64) << 20));
-  return std::string(bytes.begin(), bytes.end());
+Result<VersionedObject> DataStore::read_versioned(ResourceKind kind, const std::string& id, const std::string& file,
+                                                  int64_t max_bytes) const {
+  if (!valid_id(id)) return Status(StatusCode::kNotFound, "no such resource '" + id + "'", "id");
+  const std::string p = path(kind, id, file);
+  const int fd = ::open(p.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) {
+    if (errno == ENOENT) return Status(StatusCode::kNotFound, "no file '" + p + "'");
+    return errno_status("cannot open", p);
+  }
+  VersionedObject out;
+  auto bytes = read_fd(fd, p, max_bytes);
+  struct stat st {};
+  const bool stat_ok = ::fstat(fd, &st) == 0;
+  ::close(fd);
+  if (!bytes) return bytes.status();
+  out.bytes = std::move(*bytes);
+  out.etag = etag_of(out.bytes);
+  if (stat_ok) {
+    const auto now = std::chrono::system_clock::now().time_since_epoch();
+    out.age_seconds = std::chrono::duration<double>(now).count() - (double(st.st_mtim.tv_sec) + 1e-9 * double(st.st_mtim.tv_nsec));
+  }
+  return out;
 }
 
-bool DataStore::exists(ResourceKind kind, const std::string& id, const std::string& file) const {
+Result<bool> DataStore::exists(ResourceKind kind, const std::string& id, const std::string& file) const {
   std::error_code ec;
-  return valid_id(id) && fs::exists(path(kind, id, file), ec);
+  if (!valid_id(id)) return false;
+  const bool there = fs::exists(path(kind, id, file), ec);
+  if (ec) return Status(StatusCode::kIo, "cannot look at '" + path(kind, id, file) + "': " + ec.message());
+  return there;
 }
 
-bool DataStore::acknowledged(ResourceKind kind, const std::string& id) const {
-  return exists(kind, id, acknowledging_file(kind));
-}
-
-std::vector<std::string> DataStore::files(ResourceKind kind, const std::string& id) const {
+Result<std::vector<std::string>> DataStore::files(ResourceKind kind, const std::string& id) const {
   std::vector<std::string> out;
+  if (!valid_id(id)) return out;
   std::error_code ec;
   for (const auto& e : fs::directory_iterator(path(kind, id), ec)) {
     const std::string name = e.path().filename().string();
@@ -153,13 +315,15 @@ std::vector<std::string> DataStore::files(ResourceKind kind, const std::string& 
   return out;
 }
 
-std::vector<std::string> DataStore::ids(ResourceKind kind) const {
+Result<std::vector<std::string>> DataStore::ids(ResourceKind kind) const {
   std::vector<std::string> out;
   std::error_code ec;
-  for (const auto& e : fs::directory_iterator(fs::path(root_) / subdir(kind), ec)) {
+  const fs::path dir = fs::path(root_) / kind_dir(kind);
+  for (const auto& e : fs::directory_iterator(dir, ec)) {
     const std::string name = e.path().filename().string();
     if (valid_id(name) && fs::exists(e.path() / acknowledging_file(kind))) out.push_back(name);
   }
+  if (ec) return Status(StatusCode::kIo, "cannot list '" + dir.string() + "': " + ec.message());
   std::sort(out.begin(), out.end());
   return out;
 }
@@ -167,28 +331,12 @@ std::vector<std::string> DataStore::ids(ResourceKind kind) const {
 Status DataStore::remove(ResourceKind kind, const std::string& id) {
   if (!valid_id(id)) return Status(StatusCode::kNotFound, "no such resource '" + id + "'", "id");
   const fs::path from = path(kind, id);
-  const fs::path trash = fs::path(root_) / subdir(kind) / (".trash-" + id);
+  const fs::path trash = fs::path(root_) / kind_dir(kind) / (".trash-" + id);
   std::error_code ec;
-  fs::rename(from, trash, ec);
+  fs::rename(from, trash, ec);  // the acknowledging file goes with the directory, atomically
   if (ec) return Status(StatusCode::kIo, "cannot delete '" + from.string() + "': " + ec.message());
   fs::remove_all(trash, ec);  // a failure here leaves a .trash- leftover that open() removes
   return Status::ok();
-}
-
-std::string DataStore::new_id(const char* prefix) {
-  static thread_local std::random_device rd;
-  uint64_t v = (uint64_t(rd()) << 32) ^ uint64_t(rd());
-  static const char* hex = "0123456789abcdef";
-  std::string id = prefix;
-  for (int i = 0; i < 16; ++i) id += hex[(v >> (4 * (15 - i))) & 15];
-  return id;
-}
-
-bool DataStore::valid_id(const std::string& id) {
-  if (id.size() < 4 || id.size() > 64) return false;
-  return std::all_of(id.begin(), id.end(), [](char c) {
-    return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_';
-  });
 }
 
 }  // namespace solidtex::server

@@ -39,14 +39,14 @@ TEST(DataStore, RoundTripsFilesAndListsOnlyAcknowledgedResources) {
   ASSERT_TRUE(DataStore::valid_id(id));
   ASSERT_TRUE((*store)->create(ResourceKind::kExemplar, id).is_ok());
   ASSERT_TRUE((*store)->write_text(ResourceKind::kExemplar, id, "xy.img", "pixels").is_ok());
-  EXPECT_TRUE((*store)->ids(ResourceKind::kExemplar).empty());  // not acknowledged yet
+  EXPECT_TRUE((*store)->ids(ResourceKind::kExemplar).value().empty());  // not acknowledged yet
   ASSERT_TRUE((*store)->write_text(ResourceKind::kExemplar, id, "meta.json", "{}").is_ok());
-  EXPECT_EQ((*store)->ids(ResourceKind::kExemplar), std::vector<std::string>{id});
+  EXPECT_EQ((*store)->ids(ResourceKind::kExemplar).value(), std::vector<std::string>{id});
   auto text = (*store)->read_text(ResourceKind::kExemplar, id, "xy.img");
   ASSERT_TRUE(text.is_ok());
   EXPECT_EQ(*text, "pixels");
   ASSERT_TRUE((*store)->remove(ResourceKind::kExemplar, id).is_ok());
-  EXPECT_TRUE((*store)->ids(ResourceKind::kExemplar).empty());
+  EXPECT_TRUE((*store)->ids(ResourceKind::kExemplar).value().empty());
   EXPECT_FALSE(fs::exists((*store)->path(ResourceKind::kExemplar, id)));
   fs::remove_all(root);
 }
@@ -65,7 +65,7 @@ TEST(DataStore, OpenRemovesAndReportsHalfWrittenLeftoversButKeepsAcknowledgedRes
   auto store = DataStore::open(root.string(), &report);
   ASSERT_TRUE(store.is_ok());
   EXPECT_EQ(report.size(), 4u);
-  EXPECT_EQ((*store)->ids(ResourceKind::kVolume), std::vector<std::string>{"vol_0123456789abcdef"});
+  EXPECT_EQ((*store)->ids(ResourceKind::kVolume).value(), std::vector<std::string>{"vol_0123456789abcdef"});
   EXPECT_TRUE(fs::exists(root / "volumes" / "vol_0123456789abcdef" / "volume.json"));
   EXPECT_FALSE(fs::exists(root / "volumes" / "vol_0123456789abcdef" / ".volume.json.tmp-42"));
   EXPECT_FALSE(fs::exists(root / "exemplars" / "ex_00000000000000aa"));
@@ -102,7 +102,7 @@ TEST(DataStore, OpenKeepsLeftoversYoungerThanTheGracePeriodAndReportsThemSkipped
   }
   EXPECT_EQ(skipped, 4) << ::testing::PrintToString(report);
   EXPECT_EQ(removed, 1) << ::testing::PrintToString(report);
-  EXPECT_TRUE((*store)->ids(ResourceKind::kExemplar).empty());  // unacknowledged: never listed
+  EXPECT_TRUE((*store)->ids(ResourceKind::kExemplar).value().empty());  // unacknowledged: never listed
   // A grace period of 0 (a single replica that knows it is alone) removes them all.
   report.clear();
   ASSERT_TRUE(DataStore::open(root.string(), &report, 0).is_ok());

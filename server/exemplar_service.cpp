@@ -1,6 +1,5 @@
 #include "exemplar_service.h"
 
-#include <fcntl.h>
 #include <signal.h>
 #include <unistd.h>
 
@@ -10,7 +9,6 @@
 #include <iostream>
 #include <condition_variable>
 #include <deque>
-#include <filesystem>
 #include <map>
 #include <mutex>
 #include <thread>
@@ -72,7 +70,7 @@ constexpr int kMaxAnalysisAttempts = 2;
 }  // namespace
 
 struct ExemplarService::Impl {
-  DataStore& store;
+  Storage& store;
   ServerConfig config;
   mutable std::mutex mutex;
   std::condition_variable wake;
@@ -83,70 +81,79 @@ struct ExemplarService::Impl {
   std::atomic<bool> stopping{false};
   int running = 0;
   // Leases (see the header): who this replica is, and the thread renewing its leases.
-  const std::string replica = DataStore::new_id("rep_");
+  const std::string replica = Storage::new_id("rep_");
   const std::string host = host_name();
   std::condition_variable renew_wake;
   std::thread renewer;
 
-  Impl(DataStore& s, const ServerConfig& c) : store(s), config(c) {}
+  Impl(Storage& s, const ServerConfig& c) : store(s), config(c) {}
 
   // --- job leases (exemplars/<id>/lease) ------------------------------------------------------
 
-  std::string lease_path(const std::string& id) const { return store.path(ResourceKind::kExemplar, id, "lease"); }
   std::string lease_text() const {
     return json{{"owner", replica}, {"host", host}, {"pid", int64_t(::getpid())},
-                {"expires", wall_seconds() + config.job_lease_s}}
+                {"seconds", config.job_lease_s}, {"expires", wall_seconds() + config.job_lease_s}}
         .dump();
   }
-  // The lease's content; null when there is none (or it cannot be read).
-  json read_lease(const std::string& id) const {
-    auto text = store.read_text(ResourceKind::kExemplar, id, "lease");
-    if (!text) return nullptr;
-    json j = json::parse(*text, nullptr, false);
-    return j.is_discarded() ? json(json::object()) : j;  // {}: being created (O_EXCL, then written)
-  }
-  bool ours(const json& lease) const { return lease.is_object() && lease.value("owner", "") == replica; }
-  // Nobody works on the job: no lease, an expired one, or one of a process on this host that is
-  // gone (kill -9, crash: so a restart on the same directory need not wait for the expiry).
-  bool orphaned(const std::string& id) const {
-    const json lease = read_lease(id);
-    if (lease.is_null()) return true;
-    if (ours(lease)) return false;
-    if (lease.empty()) {  // created but not written yet: live while younger than a lease
-      std::error_code ec;
-      const auto t = std::filesystem::last_write_time(lease_path(id), ec);
-      return ec || std::chrono::duration<double>(std::filesystem::file_time_type::clock::now() - t).count() >
-                       config.job_lease_s;
+  // The lease as stored: `present` false when there is none; `body` {} when unreadable.
+  struct Lease {
+    bool present = false;
+    json body = json::object();
+    std::string etag;
+    double age = 0;  // seconds since it was written, by the store's clock
+  };
+  Result<Lease> read_lease(const std::string& id) const {
+    auto v = store.read_versioned(ResourceKind::kExemplar, id, "lease");
+    if (!v) {
+      if (v.status().code() == StatusCode::kNotFound) return Lease{};
+      return v.status();
     }
-    const double expires = lease.value("expires", 0.0);
-    if (!(wall_seconds() < expires)) return true;
-    const int64_t pid = lease.value("pid", int64_t(0));
-    return lease.value("host", "") == host && pid > 0 && pid != ::getpid() && ::kill(pid_t(pid), 0) != 0 &&
+    Lease l;
+    l.present = true;
+    l.etag = v->etag;
+    l.age = v->age_seconds;
+    json j = json::parse(v->bytes.begin(), v->bytes.end(), nullptr, false);
+    if (!j.is_discarded() && j.is_object()) l.body = std::move(j);
+    return l;
+  }
+  bool ours(const Lease& lease) const { return lease.present && lease.body.value("owner", "") == replica; }
+  // Nobody works on the job: no lease, one not renewed for longer than its owner's lease
+  // length (its age by the store's clock, so that replicas' clocks do not enter it), or one of
+  // a process on this host that is gone (kill -9, crash: so a restart on the same store need
+  // not wait for the expiry).
+  bool orphaned(const Lease& lease) const {
+    if (!lease.present) return true;
+    if (ours(lease)) return false;
+    if (lease.age > lease.body.value("seconds", config.job_lease_s)) return true;
+    const int64_t pid = lease.body.value("pid", int64_t(0));
+    return lease.body.value("host", "") == host && pid > 0 && pid != ::getpid() && ::kill(pid_t(pid), 0) != 0 &&
            errno == ESRCH;
   }
-  // Claims the job: creates the lease (O_CREAT|O_EXCL), or replaces an orphaned one atomically
-  // (temporary file, rename). Two replicas replacing the same orphaned lease at once may both
-  // believe they won; the analysis is deterministic, so the second run only costs time.
+  // Claims the job: creates the lease if there is none (create-if-absent), or replaces an
+  // orphaned one only if it is unchanged since it was read (compare-and-swap on its etag).
+  // Of several replicas claiming at once exactly one wins; never delete-then-create, with
+  // which two could.
   bool claim(const std::string& id) {
-    const std::string path = lease_path(id);
     const std::string text = lease_text();
-    const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
-    if (fd >= 0) {
-      const bool ok = ::write(fd, text.data(), text.size()) == ssize_t(text.size()) && ::fsync(fd) == 0;
-      ::close(fd);
-      return ok;
-    }
-    if (errno != EEXIST || !orphaned(id)) return false;
-    if (!store.write_text(ResourceKind::kExemplar, id, "lease", text).is_ok()) return false;
-    return ours(read_lease(id));
+    auto created = store.create_new_text(ResourceKind::kExemplar, id, "lease", text);
+    if (created || created.status().code() != StatusCode::kAlreadyExists) return created.is_ok();
+    auto lease = read_lease(id);
+    if (!lease || !orphaned(*lease)) return false;
+    if (!lease->present) return store.create_new_text(ResourceKind::kExemplar, id, "lease", text).is_ok();
+    return store.replace_if_match(ResourceKind::kExemplar, id, "lease", as_bytes(text), lease->etag).is_ok();
   }
-  // Extends this replica's lease; false when another replica has taken the job over.
+  // Extends this replica's lease; false when another replica has taken the job over. A store
+  // that cannot be reached right now is not a takeover: the next renewal tries again.
   bool renew(const std::string& id) {
-    if (!ours(read_lease(id))) return false;
-    return store.write_text(ResourceKind::kExemplar, id, "lease", lease_text()).is_ok();
+    auto lease = read_lease(id);
+    if (!lease) return true;
+    if (!ours(*lease)) return false;
+    auto renewed = store.replace_if_match(ResourceKind::kExemplar, id, "lease", as_bytes(lease_text()), lease->etag);
+    return renewed.is_ok() || renewed.status().code() != StatusCode::kFailedPrecondition;
   }
   void release(const std::string& id) {
-    if (ours(read_lease(id))) ::unlink(lease_path(id).c_str());
+    auto lease = read_lease(id);
+    if (lease && ours(*lease)) (void)store.remove_if_match(ResourceKind::kExemplar, id, "lease", lease->etag);
   }
 
   void renew_loop() {
@@ -174,11 +181,12 @@ struct ExemplarService::Impl {
   // Brings the entry of `id` up to date with the store (mutex held): loads an acknowledged
   // exemplar this replica has not seen (uploaded through another replica), drops one whose
   // directory is gone (deleted through another replica), takes up another replica's result,
-  // and claims a job nobody works on (adopt_locked). Null: no such exemplar.
-  Entry* sync_locked(const std::string& id, std::vector<std::string>* report = nullptr) {
-    if (!DataStore::valid_id(id)) return nullptr;
+  // and claims a job nobody works on (adopt_locked). Null: no such exemplar; an error: the
+  // store could not be read (nothing changed).
+  Result<Entry*> sync_locked(const std::string& id, std::vector<std::string>* report = nullptr) {
+    if (!Storage::valid_id(id)) return nullptr;
     auto it = entries.find(id);
-    const bool acknowledged = store.acknowledged(ResourceKind::kExemplar, id);
+    SOLIDTEX_ASSIGN_OR_RETURN(const bool acknowledged, store.acknowledged(ResourceKind::kExemplar, id));
     if (it != entries.end()) {
       Entry& e = it->second;
       if (!acknowledged) {  // deleted elsewhere
@@ -197,6 +205,7 @@ struct ExemplarService::Impl {
     auto text = store.read_text(ResourceKind::kExemplar, id, "meta.json");
     auto meta = text ? parse_json_text(*text, "meta.json") : Result<json>(text.status());
     if (!meta) {
+      if (meta.status().code() == StatusCode::kResourceExhausted) return meta.status();  // the store's failure
       if (report) report->push_back("skipped exemplar " + id + ": " + meta.status().to_string());
       return nullptr;
     }
@@ -209,13 +218,16 @@ struct ExemplarService::Impl {
   }
 
   // An entry whose job this replica does not hold: the stored result when there is one, else
-  // the job itself when nobody works on it (orphaned), else left to its owner.
+  // the job itself when nobody works on it (orphaned), else left to its owner. A store that
+  // cannot be read leaves the entry as it is until the next look.
   void adopt_locked(const std::string& id, Entry& e, std::vector<std::string>* report) {
     auto say = [&](const std::string& line) {
       if (report) report->push_back(line);
       else std::cerr << "solidtex serve: " << line << "\n";
     };
-    if (store.exists(ResourceKind::kExemplar, id, "result.json")) {
+    const auto has_result = store.exists(ResourceKind::kExemplar, id, "result.json");
+    if (!has_result) return;
+    if (*has_result) {
       auto r = store.read_text(ResourceKind::kExemplar, id, "result.json");
       auto record = r ? parse_json_text(*r, "result.json") : Result<json>(r.status());
       if (record) {
@@ -227,7 +239,8 @@ struct ExemplarService::Impl {
       return;
     }
     e.state = State::kRunning;  // another replica's, as far as this one knows
-    if (!orphaned(id)) return;
+    const auto lease = read_lease(id);
+    if (!lease || !orphaned(*lease)) return;
     if (attempts(id) >= kMaxAnalysisAttempts) {
       const json record{{"error", status_json(Status(StatusCode::kInternal,
                                                      "the analysis was interrupted " + std::to_string(kMaxAnalysisAttempts) +
@@ -247,9 +260,12 @@ struct ExemplarService::Impl {
         " (its lease was missing or had expired)");
   }
 
-  // Every exemplar of the store, and none that is gone from it (mutex held).
+  // Every exemplar of the store, and none that is gone from it (mutex held); what this replica
+  // knows when the store cannot be listed (ExemplarService::list).
   void sync_all_locked() {
-    for (const std::string& id : stored_and_loaded_ids(store, ResourceKind::kExemplar, entries)) sync_locked(id);
+    auto ids = stored_and_loaded_ids(store, ResourceKind::kExemplar, entries);
+    if (ids)
+      for (const std::string& id : *ids) (void)sync_locked(id);
   }
 
   // `max_bytes` > 0: the analysis cost limit, checked as the images are decoded (uploads).
@@ -481,7 +497,7 @@ struct ExemplarService::Impl {
   }
 };
 
-ExemplarService::ExemplarService(DataStore& store, const ServerConfig& config)
+ExemplarService::ExemplarService(Storage& store, const ServerConfig& config)
     : impl_(std::make_unique<Impl>(store, config)) {}
 
 ExemplarService::~ExemplarService() { shutdown(); }
@@ -489,7 +505,8 @@ ExemplarService::~ExemplarService() { shutdown(); }
 Status ExemplarService::start(std::vector<std::string>* report) {
   {
     std::lock_guard<std::mutex> g(impl_->mutex);
-    for (const std::string& id : impl_->store.ids(ResourceKind::kExemplar)) impl_->sync_locked(id, report);
+    SOLIDTEX_ASSIGN_OR_RETURN(std::vector<std::string> ids, impl_->store.ids(ResourceKind::kExemplar));
+    for (const std::string& id : ids) SOLIDTEX_RETURN_IF_ERROR(impl_->sync_locked(id, report).status());
   }
   for (int i = 0; i < impl_->config.analysis_threads; ++i) impl_->threads.emplace_back([this] { impl_->worker(); });
   impl_->renewer = std::thread([this] { impl_->renew_loop(); });
@@ -542,11 +559,11 @@ Result<json> ExemplarService::upload(ExemplarUpload up) {
                       " MB (--max-request-mb): send a smaller image or fewer levels",
                   "xy");
 
-  const std::string id = DataStore::new_id("ex_");
+  const std::string id = Storage::new_id("ex_");
   json parts = json::array();
   SOLIDTEX_RETURN_IF_ERROR(impl_->store.create(ResourceKind::kExemplar, id));
   for (const auto& [name, bytes] : up.parts) {
-    SOLIDTEX_RETURN_IF_ERROR(impl_->store.write(ResourceKind::kExemplar, id, name + ".img", bytes));
+    SOLIDTEX_RETURN_IF_ERROR(impl_->store.create_new(ResourceKind::kExemplar, id, name + ".img", bytes).status());
     parts.push_back(name);
   }
   // The job's lease before the acknowledgement: no other replica ever sees this job unclaimed.
@@ -567,7 +584,7 @@ Result<json> ExemplarService::upload(ExemplarUpload up) {
             {"has_mask", set.has_mask()},
             {"width", xy.width},
             {"height", xy.height}};
-  Status st = impl_->store.write_text(ResourceKind::kExemplar, id, "meta.json", e.meta.dump());
+  Status st = impl_->store.create_new_text(ResourceKind::kExemplar, id, "meta.json", e.meta.dump()).status();
   if (!st.is_ok()) {
     impl_->store.remove(ResourceKind::kExemplar, id);
     return st;
@@ -583,7 +600,7 @@ Result<json> ExemplarService::upload(ExemplarUpload up) {
 
 Result<json> ExemplarService::get(const std::string& id) const {
   std::lock_guard<std::mutex> g(impl_->mutex);
-  const Entry* e = impl_->sync_locked(id);
+  SOLIDTEX_ASSIGN_OR_RETURN(const Entry* e, impl_->sync_locked(id));
   if (!e) return Status(StatusCode::kNotFound, "no exemplar '" + id + "'", "id");
   return impl_->exemplar_json(id, *e);
 }
@@ -600,14 +617,16 @@ Result<json> ExemplarService::job(const std::string& job_id) const {
   std::lock_guard<std::mutex> g(impl_->mutex);
   if (job_id.rfind("job_", 0) == 0) {
     const std::string id = "ex_" + job_id.substr(4);
-    if (const Entry* e = impl_->sync_locked(id)) return impl_->job_json(id, *e);
+    SOLIDTEX_ASSIGN_OR_RETURN(const Entry* e, impl_->sync_locked(id));
+    if (e) return impl_->job_json(id, *e);
   }
   return Status(StatusCode::kNotFound, "no job '" + job_id + "'", "id");
 }
 
 Status ExemplarService::remove(const std::string& id, const std::function<bool(const std::string&)>& in_use) {
   std::unique_lock<std::mutex> g(impl_->mutex);
-  if (!impl_->sync_locked(id)) return Status(StatusCode::kNotFound, "no exemplar '" + id + "'", "id");
+  SOLIDTEX_ASSIGN_OR_RETURN(const Entry* found, impl_->sync_locked(id));
+  if (!found) return Status(StatusCode::kNotFound, "no exemplar '" + id + "'", "id");
   auto it = impl_->entries.find(id);
   // Another replica's job is not stopped from here: its owner notices the directory is gone
   // (its writes fail harmlessly) and drops the exemplar at its next look.
@@ -633,7 +652,7 @@ Status ExemplarService::remove(const std::string& id, const std::function<bool(c
 
 Status ExemplarService::check_ready(const std::string& id) const {
   std::lock_guard<std::mutex> g(impl_->mutex);
-  const Entry* e = impl_->sync_locked(id);
+  SOLIDTEX_ASSIGN_OR_RETURN(const Entry* e, impl_->sync_locked(id));
   if (!e) return Status(StatusCode::kNotFound, "no exemplar '" + id + "'", "exemplar");
   if (e->state != State::kReady)
     return Status(StatusCode::kFailedPrecondition, "exemplar '" + id + "' is not ready", "exemplar");
@@ -662,7 +681,7 @@ Result<std::shared_ptr<const Table>> ExemplarService::table(const std::string& i
 Result<std::vector<uint8_t>> ExemplarService::table_bytes(const std::string& id) const {
   {
     std::lock_guard<std::mutex> g(impl_->mutex);
-    const Entry* e = impl_->sync_locked(id);
+    SOLIDTEX_ASSIGN_OR_RETURN(const Entry* e, impl_->sync_locked(id));
     if (!e) return Status(StatusCode::kNotFound, "no exemplar '" + id + "'", "id");
     if (e->state != State::kReady)
       return Status(StatusCode::kFailedPrecondition, "exemplar '" + id + "' is not ready", "id");

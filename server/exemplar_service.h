@@ -2,7 +2,7 @@
 //
 // upload() decodes every image (dimensions checked from the header first) and builds the
 // ExemplarSet synchronously, so bad input is refused before anything is stored; then it stores
-// the uploaded bytes and meta.json (the acknowledgement: see data_store.h) and queues the
+// the uploaded bytes and meta.json (the acknowledgement: see storage.h, data_store.h) and queues the
 // analysis. Analyses run on `analysis_threads` threads of their own, at most `max_jobs`
 // queued or running (beyond: kRateLimited). A job's id derives from its exemplar's, so a job
 // survives restarts: start() re-queues every acknowledged exemplar without a result, and an
@@ -12,16 +12,21 @@
 // Several replicas on one data directory (README): the store is the truth. Every read (get,
 // list, job, check_ready, table) first brings its entries up to date with the store: an
 // exemplar uploaded through another replica is loaded, one deleted through another replica is
-// dropped (404), and another replica's result is taken up. A job is claimed by a lease file,
-// exemplars/<id>/lease ({"owner", "host", "pid", "expires"}: created O_CREAT|O_EXCL by the
-// uploading replica before meta.json, renewed every third of --job-lease-seconds while the job
-// is queued or running here, removed once result.json is written or at shutdown). A replica
-// that finds an exemplar without result.json whose lease is missing, expired, or held by a
-// process of the same host that no longer exists, takes the job over (atomic replace of the
-// lease) and runs it. It looks at start-up and whenever a client reads that exemplar or its job
-// (including lists); there is no background scan. Lease expiry compares wall clocks: replicas'
-// clocks must agree to well within a lease, and hosts sharing a directory need distinct names.
-// Thread-safe.
+// dropped (404), and another replica's result is taken up. A job is claimed by a lease object,
+// exemplars/<id>/lease ({"owner", "host", "pid", "seconds", "expires"}), through the store's
+// conditional operations (storage.h): created if absent by the uploading replica before
+// meta.json, renewed every third of --job-lease-seconds while the job is queued or running
+// here (replace if its etag is unchanged: a replica whose lease was taken over learns it from
+// the failed renewal), removed once result.json is written or at shutdown (remove if
+// unchanged). A replica that finds an exemplar without result.json whose lease is missing,
+// older than its owner's "seconds", or held by a process of the same host that no longer
+// exists, takes the job over (create if absent, or replace if unchanged: of several replicas
+// exactly one wins) and runs it. It looks at start-up and whenever a client reads that
+// exemplar or its job (including lists); there is no background scan. A lease's age is
+// measured by the store's clock (S3: the server's; local: the file's mtime against this
+// host's clock), and hosts sharing a store need distinct names. A store that cannot be read
+// answers kResourceExhausted (503) for reads of one exemplar; list() then shows what this
+// replica knows. Thread-safe.
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -33,7 +38,7 @@
 #include <vector>
 
 #include "analysis/analysis_params.h"
-#include "data_store.h"
+#include "storage.h"
 #include "server_config.h"
 #include "analysis/table.h"
 
@@ -50,7 +55,7 @@ struct ExemplarUpload {
 
 class ExemplarService {
  public:
-  ExemplarService(DataStore& store, const ServerConfig& config);
+  ExemplarService(Storage& store, const ServerConfig& config);
   ~ExemplarService();  // shutdown()
 
   Status start(std::vector<std::string>* report);

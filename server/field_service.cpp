@@ -70,17 +70,29 @@ Status check_revision(std::optional<int> expected, int current) {
                 "revision");
 }
 
+// A revision's .stf without its .json older than this is a leftover of a writer that died
+// between the two (writing both takes milliseconds); a younger one is a write in progress.
+constexpr double kRevisionLeftoverSeconds = 60;
+
+// 409: revision `revision` was claimed by another writer (another replica) first.
+Status revision_taken(int revision) {
+  return Status(StatusCode::kFailedPrecondition,
+                "revision " + std::to_string(revision) +
+                    " of the field was written meanwhile through another replica (or is being written); nothing was "
+                    "changed: read the field and retry",
+                "revision");
+}
 
 }  // namespace
 
 struct FieldService::Impl {
-  DataStore& store;
+  Storage& store;
   ServerConfig config;
   mutable std::mutex mutex;
   std::map<std::string, FieldEntry> entries;
   uint64_t tick = 0;
 
-  Impl(DataStore& s, const ServerConfig& c) : store(s), config(c) {}
+  Impl(Storage& s, const ServerConfig& c) : store(s), config(c) {}
 
   // Solves a whole sketch within the configured grid-size limit (422 beyond it).
   Result<std::unique_ptr<FieldSolver>> solve(const Sketch& sketch, Interrupter& interrupter, FieldSolveStats& stats) const {
@@ -112,9 +124,29 @@ struct FieldService::Impl {
   }
 
   // Writes `f` as revision `revision` (the .stf, then its .json holding `info`) and returns the info.
+  // Both files are write-once (create_new), so that two replicas changing one field at once
+  // never both write revision N: the one that creates r<N>.stf first goes on, the other gets
+  // revision_taken (409) with nothing written, its change being based on a revision that is no
+  // longer the newest (retrying with N+1 would silently drop the winner's curve).
   Result<json> write_revision(const std::string& id, int revision, const StoredField& f, json info, FieldEntry& e) {
-    SOLIDTEX_RETURN_IF_ERROR(store.write(ResourceKind::kField, id, stf_name(revision), encode_field(f)));
-    SOLIDTEX_RETURN_IF_ERROR(store.write_text(ResourceKind::kField, id, json_name(revision), info.dump()));
+    const std::vector<uint8_t> bytes = encode_field(f);
+    auto stf = store.create_new(ResourceKind::kField, id, stf_name(revision), bytes);
+    if (!stf && stf.status().code() == StatusCode::kAlreadyExists) {
+      // An old .stf without its .json is no live writer's: taken back (only if unchanged since
+      // read, so that two replicas taking it back cannot both succeed).
+      SOLIDTEX_ASSIGN_OR_RETURN(bool done, store.exists(ResourceKind::kField, id, json_name(revision)));
+      auto old = done ? Result<VersionedObject>(Status(StatusCode::kAlreadyExists, "written"))
+                      : store.read_versioned(ResourceKind::kField, id, stf_name(revision), int64_t(1) << 32);
+      if (old && old->age_seconds > kRevisionLeftoverSeconds &&
+          store.remove_if_match(ResourceKind::kField, id, stf_name(revision), old->etag).is_ok())
+        stf = store.create_new(ResourceKind::kField, id, stf_name(revision), bytes);
+    }
+    if (!stf) return stf.status().code() == StatusCode::kAlreadyExists ? revision_taken(revision) : stf.status();
+    auto acknowledged = store.create_new_text(ResourceKind::kField, id, json_name(revision), info.dump());
+    if (!acknowledged) {
+      (void)store.remove_if_match(ResourceKind::kField, id, stf_name(revision), *stf);  // no leftover to wait out
+      return acknowledged.status().code() == StatusCode::kAlreadyExists ? revision_taken(revision) : acknowledged.status();
+    }
     SOLIDTEX_ASSIGN_OR_RETURN(e.field, QuatGridField::create(f.origin, f.spacing, f.dims, f.nodes, f.log_scales));
     e.revision = revision;
     e.info = info;
@@ -143,10 +175,11 @@ struct FieldService::Impl {
   // leaves the previous revision current), decoded into `e`.
   Status load_newest(const std::string& id, FieldEntry& e) const {
     int revision = 0;
-    for (const std::string& f : store.files(ResourceKind::kField, id)) {
+    SOLIDTEX_ASSIGN_OR_RETURN(std::vector<std::string> files, store.files(ResourceKind::kField, id));
+    for (const std::string& f : files) {
       if (f.size() > 6 && f[0] == 'r' && f.ends_with(".json")) {
         const int r = std::atoi(f.substr(1, f.size() - 6).c_str());
-        if (r > revision && store.exists(ResourceKind::kField, id, stf_name(r))) revision = r;
+        if (r > revision && std::binary_search(files.begin(), files.end(), stf_name(r))) revision = r;
       }
     }
     SOLIDTEX_ASSIGN_OR_RETURN(std::string text, store.read_text(ResourceKind::kField, id, json_name(revision)));
@@ -162,19 +195,21 @@ struct FieldService::Impl {
   // Read-through (mutex held; several replicas on one data directory): loads a field created
   // through another replica, takes up revisions another replica added (a newer r<N>.json; the
   // live solver, of an older revision, is dropped), and drops a field deleted through another
-  // replica. Null: no such field. Changes of one field through two replicas at the same
-  // moment are not serialised across them (each serialises its own).
-  FieldEntry* sync_locked(const std::string& id, std::vector<std::string>* report = nullptr) {
-    if (!DataStore::valid_id(id)) return nullptr;
+  // replica. Null: no such field; an error: the store could not be read (nothing changed).
+  // Changes of one field through two replicas at the same moment are serialised by the store:
+  // revisions are write-once (write_revision), the later change answers 409.
+  Result<FieldEntry*> sync_locked(const std::string& id, std::vector<std::string>* report = nullptr) {
+    if (!Storage::valid_id(id)) return nullptr;
     auto it = entries.find(id);
-    if (!store.acknowledged(ResourceKind::kField, id)) {
+    SOLIDTEX_ASSIGN_OR_RETURN(bool acknowledged, store.acknowledged(ResourceKind::kField, id));
+    if (!acknowledged) {
       if (it != entries.end()) entries.erase(it);
       return nullptr;
     }
     if (it != entries.end()) {
       FieldEntry& e = it->second;
-      if (store.exists(ResourceKind::kField, id, json_name(e.revision + 1)) &&
-          store.exists(ResourceKind::kField, id, stf_name(e.revision + 1))) {
+      SOLIDTEX_ASSIGN_OR_RETURN(bool has_next, store.exists(ResourceKind::kField, id, json_name(e.revision + 1)));
+      if (has_next) {  // its .json is written last: the .stf is there too
         FieldEntry newer;
         if (load_newest(id, newer).is_ok() && newer.revision > e.revision) {
           e.field = newer.field;
@@ -187,6 +222,7 @@ struct FieldService::Impl {
     }
     FieldEntry e;
     if (Status st = load_newest(id, e); !st.is_ok()) {
+      if (st.code() == StatusCode::kResourceExhausted) return st;  // the store's failure, not the field's
       if (report) report->push_back("skipped field " + id + ": " + st.to_string());
       return nullptr;
     }
@@ -196,23 +232,27 @@ struct FieldService::Impl {
   Status lock_change(const std::string& id, FieldChangeLock& out, Interrupter& interrupter) {
     {
       std::lock_guard<std::mutex> g(mutex);
-      FieldEntry* e = sync_locked(id);
+      SOLIDTEX_ASSIGN_OR_RETURN(FieldEntry* e, sync_locked(id));
       if (!e) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
       out.mutex = e->busy;
     }
     return lock_busy(*out.mutex, out.lock, interrupter);
   }
+  // A list shows what this replica knows when the store cannot be read (FieldService::list).
   void sync_all_locked() {
-    for (const std::string& id : stored_and_loaded_ids(store, ResourceKind::kField, entries)) sync_locked(id);
+    auto ids = stored_and_loaded_ids(store, ResourceKind::kField, entries);
+    if (ids)
+      for (const std::string& id : *ids) (void)sync_locked(id);
   }
 };
 
-FieldService::FieldService(DataStore& store, const ServerConfig& config) : impl_(std::make_unique<Impl>(store, config)) {}
+FieldService::FieldService(Storage& store, const ServerConfig& config) : impl_(std::make_unique<Impl>(store, config)) {}
 FieldService::~FieldService() = default;
 
 Status FieldService::start(std::vector<std::string>* report) {
   std::lock_guard<std::mutex> g(impl_->mutex);
-  for (const std::string& id : impl_->store.ids(ResourceKind::kField)) impl_->sync_locked(id, report);
+  SOLIDTEX_ASSIGN_OR_RETURN(std::vector<std::string> ids, impl_->store.ids(ResourceKind::kField));
+  for (const std::string& id : ids) SOLIDTEX_RETURN_IF_ERROR(impl_->sync_locked(id, report).status());
   return Status::ok();
 }
 
@@ -220,7 +260,7 @@ Result<json> FieldService::create(const std::string& sketch_text, Interrupter& i
   SOLIDTEX_ASSIGN_OR_RETURN(Sketch sketch, parse_sketch_json(sketch_text));
   FieldSolveStats stats;
   SOLIDTEX_ASSIGN_OR_RETURN(auto solver, impl_->solve(sketch, interrupter, stats));
-  const std::string id = DataStore::new_id("fld_");
+  const std::string id = Storage::new_id("fld_");
   SOLIDTEX_RETURN_IF_ERROR(impl_->store.create(ResourceKind::kField, id));
   FieldEntry e;
   auto info = impl_->store_revision(id, 1, *solver, stats, sketch_text, e);
@@ -287,7 +327,8 @@ Result<json> FieldService::add_curve(const std::string& id, const std::string& c
   std::unique_ptr<FieldSolver> solver;
   {
     std::lock_guard<std::mutex> g(impl_->mutex);
-    if (!impl_->sync_locked(id)) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
+    SOLIDTEX_ASSIGN_OR_RETURN(FieldEntry* found, impl_->sync_locked(id));
+    if (!found) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
     auto it = impl_->entries.find(id);
     revision = it->second.revision;
     SOLIDTEX_RETURN_IF_ERROR(check_revision(expected_revision, revision));
@@ -329,7 +370,8 @@ Result<json> FieldService::remove_last_curve(const std::string& id, Interrupter&
   int revision = 0;
   {
     std::lock_guard<std::mutex> g(impl_->mutex);
-    if (!impl_->sync_locked(id)) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
+    SOLIDTEX_ASSIGN_OR_RETURN(FieldEntry* found, impl_->sync_locked(id));
+    if (!found) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
     auto it = impl_->entries.find(id);
     revision = it->second.revision;
     SOLIDTEX_RETURN_IF_ERROR(check_revision(expected_revision, revision));
@@ -390,7 +432,7 @@ Result<json> FieldService::remove_last_curve(const std::string& id, Interrupter&
 
 Result<json> FieldService::get(const std::string& id) const {
   std::lock_guard<std::mutex> g(impl_->mutex);
-  const FieldEntry* e = impl_->sync_locked(id);
+  SOLIDTEX_ASSIGN_OR_RETURN(const FieldEntry* e, impl_->sync_locked(id));
   if (!e) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
   return e->info;
 }
@@ -409,7 +451,8 @@ Status FieldService::remove(const std::string& id, Interrupter& interrupter) {
   FieldChangeLock one_at_a_time;
   SOLIDTEX_RETURN_IF_ERROR(impl_->lock_change(id, one_at_a_time, interrupter));
   std::lock_guard<std::mutex> g(impl_->mutex);
-  if (!impl_->sync_locked(id)) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
+  SOLIDTEX_ASSIGN_OR_RETURN(FieldEntry* found, impl_->sync_locked(id));
+  if (!found) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
   auto it = impl_->entries.find(id);
   SOLIDTEX_RETURN_IF_ERROR(impl_->store.remove(ResourceKind::kField, id));
   impl_->entries.erase(it);
@@ -420,7 +463,7 @@ Result<std::vector<uint8_t>> FieldService::file_bytes(const std::string& id, int
   int r = 0;
   {
     std::lock_guard<std::mutex> g(impl_->mutex);
-    const FieldEntry* e = impl_->sync_locked(id);
+    SOLIDTEX_ASSIGN_OR_RETURN(const FieldEntry* e, impl_->sync_locked(id));
     if (!e) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
     r = e->revision;
   }
@@ -433,7 +476,7 @@ Result<json> FieldService::sample_frames(const std::string& id, const WorldPoint
   std::shared_ptr<const QuatGridField> field;
   {
     std::lock_guard<std::mutex> g(impl_->mutex);
-    const FieldEntry* e = impl_->sync_locked(id);
+    SOLIDTEX_ASSIGN_OR_RETURN(const FieldEntry* e, impl_->sync_locked(id));
     if (!e) return Status(StatusCode::kNotFound, "no field '" + id + "'", "id");
     field = e->field;
   }

@@ -6,10 +6,14 @@
 // curve re-solves the stored sketch first. Solves poll the interrupter throughout (FieldSolver:
 // at every conjugate-gradient iteration), and grids beyond config.max_field_nodes are
 // refused before anything is allocated.
-// Reads go through the store (several replicas on one data directory, README): a field created
+// Reads go through the store (several replicas on one store, README): a field created
 // through another replica is loaded, a revision added through another is taken up at the next
-// access, and a field deleted through another answers 404.
-// Thread-safe; operations on one field are serialised (within one replica).
+// access, and a field deleted through another answers 404. A failure of the store is answered
+// as such (kResourceExhausted from S3: 503); list() then shows what this replica knows.
+// Thread-safe; operations on one field are serialised within one replica, and across replicas
+// by the store: a revision's files are write-once, so of two changes of one field made at once
+// through two replicas the later one fails with kFailedPrecondition naming "revision" (409)
+// and changes nothing.
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -18,7 +22,7 @@
 #include <optional>
 #include <string>
 
-#include "data_store.h"
+#include "storage.h"
 #include "field/field_file.h"
 #include "core/interrupter.h"
 #include "mesh/mesh.h"
@@ -42,7 +46,7 @@ struct MeshFieldOptions {
 
 class FieldService {
  public:
-  FieldService(DataStore& store, const ServerConfig& config);
+  FieldService(Storage& store, const ServerConfig& config);
   ~FieldService();
 
   Status start(std::vector<std::string>* report);

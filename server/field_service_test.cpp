@@ -1,5 +1,7 @@
 #include "field_service.h"
 
+#include "data_store.h"
+
 #include <gtest/gtest.h>
 
 #include <unistd.h>
@@ -84,7 +86,7 @@ struct Fixture {
     return id;
   }
   int revision(const std::string& id) { return fields->get(id).value()["revision"].get<int>(); }
-  bool has_file(const std::string& id, const std::string& name) { return store->exists(ResourceKind::kField, id, name); }
+  bool has_file(const std::string& id, const std::string& name) { return store->exists(ResourceKind::kField, id, name).value(); }
 };
 
 TEST(FieldService, AStaleRevisionChangesNothingAndSaysTheCurrentOne) {
@@ -198,6 +200,57 @@ TEST(FieldService, DeletingWaitsForARunningChangeInsteadOfBreakingIt) {
   EXPECT_FALSE(fs::exists(f.store->path(ResourceKind::kField, id)));
   // Changes that were waiting find no field.
   EXPECT_EQ(f.fields->add_curve(id, kCurve3, null_interrupter()).status().code(), StatusCode::kNotFound);
+}
+
+// Two replicas on one store change one field at once: the revision's files are write-once, so
+// the one that writes revision N second answers 409 naming "revision" and writes nothing; the
+// winner's curve stands and the loser can retry on the new revision.
+TEST(FieldService, OfTwoReplicasWritingTheSameRevisionTheSecondAnswers409) {
+  Fixture f;
+  auto created = f.fields->create(kSketch, null_interrupter());
+  ASSERT_TRUE(created.is_ok()) << created.status().to_string();
+  const std::string id = (*created)["id"];
+  FieldService other(*f.store, f.config);  // a second replica on the same store
+  ASSERT_TRUE(other.start(nullptr).is_ok());
+  ASSERT_EQ(other.get(id).value()["revision"], 1);
+  Gate gate;
+  Result<nlohmann::json> slow = Status(StatusCode::kInternal, "not run");
+  std::thread replica_a([&] { slow = f.fields->add_curve(id, kCurve2, gate); });
+  gate.wait_entered();  // A works on revision 2 (its solve polls the gate)
+  auto fast = other.add_curve(id, kCurve3, null_interrupter());
+  ASSERT_TRUE(fast.is_ok()) << fast.status().to_string();
+  EXPECT_EQ((*fast)["revision"], 2);
+  const auto winner = f.store->read(ResourceKind::kField, id, "r2.stf").value();
+  gate.release();
+  replica_a.join();
+  ASSERT_FALSE(slow.is_ok());
+  EXPECT_EQ(slow.status().code(), StatusCode::kFailedPrecondition);
+  EXPECT_EQ(slow.status().field(), "revision");
+  EXPECT_EQ(f.store->read(ResourceKind::kField, id, "r2.stf").value(), winner);
+  EXPECT_FALSE(f.has_file(id, "r3.stf"));
+  // The loser sees the winner's revision and its retry becomes revision 3.
+  EXPECT_EQ(f.revision(id), 2);
+  auto retried = f.fields->add_curve(id, kCurve2, null_interrupter(), 2);
+  ASSERT_TRUE(retried.is_ok()) << retried.status().to_string();
+  EXPECT_EQ((*retried)["revision"], 3);
+}
+
+// A writer that died between a revision's .stf and its .json leaves the .stf alone: the next
+// change is refused while it may still be a write in progress, then takes the number back.
+TEST(FieldService, ARevisionLeftBehalfWrittenIsTakenBackOnceOld) {
+  Fixture f;
+  const std::string id = f.field_at_revision_2();
+  const fs::path leftover = f.store->path(ResourceKind::kField, id, "r3.stf");
+  fs::copy_file(f.store->path(ResourceKind::kField, id, "r2.stf"), leftover);
+  auto refused = f.fields->add_curve(id, kCurve3, null_interrupter());
+  ASSERT_FALSE(refused.is_ok());
+  EXPECT_EQ(refused.status().code(), StatusCode::kFailedPrecondition);
+  EXPECT_EQ(refused.status().field(), "revision");
+  fs::last_write_time(leftover, fs::file_time_type::clock::now() - std::chrono::minutes(5));
+  auto added = f.fields->add_curve(id, kCurve3, null_interrupter());
+  ASSERT_TRUE(added.is_ok()) << added.status().to_string();
+  EXPECT_EQ((*added)["revision"], 3);
+  EXPECT_TRUE(f.has_file(id, "r3.json"));
 }
 
 }  // namespace

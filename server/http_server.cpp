@@ -14,7 +14,7 @@
 #include <unordered_map>
 
 #include "api.h"
-#include "data_store.h"
+#include "storage.h"
 #include "http_errors.h"
 #include "routes.h"
 
@@ -104,7 +104,7 @@ class Server {
 
   Status run() {
     std::vector<std::string> report;
-    SOLIDTEX_ASSIGN_OR_RETURN(store_, DataStore::open(config_.data_dir, &report));
+    SOLIDTEX_ASSIGN_OR_RETURN(store_, open_storage(config_.storage_config(), &report));
     exemplars_ = std::make_unique<ExemplarService>(*store_, config_);
     fields_ = std::make_unique<FieldService>(*store_, config_);
     meshes_ = std::make_unique<MeshService>(*store_, config_);
@@ -153,7 +153,7 @@ class Server {
                     "--port");
     }
     std::cerr << "solidtex serve: listening on http://" << config_.host << ":" << config_.port << " (data "
-              << store_->root() << ", " << config_.threads << " workers, queue " << config_.queue << ")" << std::endl;
+              << store_->describe() << ", " << config_.threads << " workers, queue " << config_.queue << ")" << std::endl;
     if (config_.web_root.empty())
       std::cerr << "solidtex serve: no browser app (--web-root names its directory)" << std::endl;
     else
@@ -324,7 +324,7 @@ class Server {
   }
 
   ServerConfig config_;
-  std::unique_ptr<DataStore> store_;
+  std::unique_ptr<Storage> store_;
   std::unique_ptr<ExemplarService> exemplars_;
   std::unique_ptr<FieldService> fields_;
   std::unique_ptr<VolumeService> volumes_;

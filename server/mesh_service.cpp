@@ -28,19 +28,21 @@ json mesh_summary(const Mesh& m) {
 }
 
 struct MeshService::Impl {
-  DataStore& store;
+  Storage& store;
   ServerConfig config;
   mutable std::mutex mutex;
   std::map<std::string, json> meta;
   std::map<std::string, std::shared_ptr<const Mesh>> decoded;
-  Impl(DataStore& s, const ServerConfig& c) : store(s), config(c) {}
+  Impl(Storage& s, const ServerConfig& c) : store(s), config(c) {}
 
   // Read-through (mutex held; several replicas on one data directory): loads a mesh stored
-  // through another replica, drops one deleted through another. False: no such mesh.
-  bool sync_locked(const std::string& id, std::vector<std::string>* report = nullptr) {
-    if (!DataStore::valid_id(id)) return false;
+  // through another replica, drops one deleted through another. False: no such mesh; an
+  // error: the store could not be read.
+  Result<bool> sync_locked(const std::string& id, std::vector<std::string>* report = nullptr) {
+    if (!Storage::valid_id(id)) return false;
     auto it = meta.find(id);
-    if (!store.acknowledged(ResourceKind::kMesh, id)) {
+    SOLIDTEX_ASSIGN_OR_RETURN(bool acknowledged, store.acknowledged(ResourceKind::kMesh, id));
+    if (!acknowledged) {
       if (it != meta.end()) meta.erase(it);
       decoded.erase(id);
       return false;
@@ -49,23 +51,28 @@ struct MeshService::Impl {
     auto text = store.read_text(ResourceKind::kMesh, id, "meta.json");
     auto j = text ? parse_json_text(*text, "meta.json") : Result<json>(text.status());
     if (!j) {
+      if (j.status().code() == StatusCode::kResourceExhausted) return j.status();  // the store's failure
       if (report) report->push_back("skipped mesh " + id + ": " + j.status().to_string());
       return false;
     }
     meta.emplace(id, *j);
     return true;
   }
+  // A list shows what this replica knows when the store cannot be read (MeshService::list).
   void sync_all_locked() {
-    for (const std::string& id : stored_and_loaded_ids(store, ResourceKind::kMesh, meta)) sync_locked(id);
+    auto ids = stored_and_loaded_ids(store, ResourceKind::kMesh, meta);
+    if (ids)
+      for (const std::string& id : *ids) (void)sync_locked(id);
   }
 };
 
-MeshService::MeshService(DataStore& store, const ServerConfig& config) : impl_(std::make_unique<Impl>(store, config)) {}
+MeshService::MeshService(Storage& store, const ServerConfig& config) : impl_(std::make_unique<Impl>(store, config)) {}
 MeshService::~MeshService() = default;
 
 Status MeshService::start(std::vector<std::string>* report) {
   std::lock_guard<std::mutex> g(impl_->mutex);
-  for (const std::string& id : impl_->store.ids(ResourceKind::kMesh)) impl_->sync_locked(id, report);
+  SOLIDTEX_ASSIGN_OR_RETURN(std::vector<std::string> ids, impl_->store.ids(ResourceKind::kMesh));
+  for (const std::string& id : ids) SOLIDTEX_RETURN_IF_ERROR(impl_->sync_locked(id, report).status());
   return Status::ok();
 }
 
@@ -73,13 +80,13 @@ Result<Mesh> MeshService::decode(std::span<const uint8_t> bytes) const { return 
 
 Result<json> MeshService::upload(std::span<const uint8_t> bytes, const std::string& name) {
   SOLIDTEX_ASSIGN_OR_RETURN(Mesh m, decode(bytes));
-  const std::string id = DataStore::new_id("mesh_");
+  const std::string id = Storage::new_id("mesh_");
   json j = mesh_summary(m);
   j["id"] = id;
   j["name"] = name;
   SOLIDTEX_RETURN_IF_ERROR(impl_->store.create(ResourceKind::kMesh, id));
-  Status st = impl_->store.write(ResourceKind::kMesh, id, "source.mesh", bytes);
-  if (st.is_ok()) st = impl_->store.write_text(ResourceKind::kMesh, id, "meta.json", j.dump());
+  Status st = impl_->store.create_new(ResourceKind::kMesh, id, "source.mesh", bytes).status();
+  if (st.is_ok()) st = impl_->store.create_new_text(ResourceKind::kMesh, id, "meta.json", j.dump()).status();
   if (!st.is_ok()) {
     impl_->store.remove(ResourceKind::kMesh, id);
     return st;
@@ -92,7 +99,8 @@ Result<json> MeshService::upload(std::span<const uint8_t> bytes, const std::stri
 
 Result<json> MeshService::get(const std::string& id) const {
   std::lock_guard<std::mutex> g(impl_->mutex);
-  if (!impl_->sync_locked(id)) return Status(StatusCode::kNotFound, "no mesh '" + id + "'", "id");
+  SOLIDTEX_ASSIGN_OR_RETURN(bool found, impl_->sync_locked(id));
+  if (!found) return Status(StatusCode::kNotFound, "no mesh '" + id + "'", "id");
   return impl_->meta.at(id);
 }
 
@@ -106,7 +114,8 @@ json MeshService::list() const {
 
 Status MeshService::remove(const std::string& id) {
   std::lock_guard<std::mutex> g(impl_->mutex);
-  if (!impl_->sync_locked(id)) return Status(StatusCode::kNotFound, "no mesh '" + id + "'", "id");
+  SOLIDTEX_ASSIGN_OR_RETURN(bool found, impl_->sync_locked(id));
+  if (!found) return Status(StatusCode::kNotFound, "no mesh '" + id + "'", "id");
   auto it = impl_->meta.find(id);
   SOLIDTEX_RETURN_IF_ERROR(impl_->store.remove(ResourceKind::kMesh, id));
   impl_->meta.erase(it);
@@ -117,7 +126,8 @@ Status MeshService::remove(const std::string& id) {
 Result<std::shared_ptr<const Mesh>> MeshService::mesh(const std::string& id) {
   {
     std::lock_guard<std::mutex> g(impl_->mutex);
-    if (!impl_->sync_locked(id)) return Status(StatusCode::kNotFound, "no mesh '" + id + "'", "mesh");
+    SOLIDTEX_ASSIGN_OR_RETURN(bool found, impl_->sync_locked(id));
+    if (!found) return Status(StatusCode::kNotFound, "no mesh '" + id + "'", "mesh");
     auto it = impl_->decoded.find(id);
     if (it != impl_->decoded.end()) return it->second;
   }

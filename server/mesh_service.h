@@ -11,7 +11,7 @@
 #include <memory>
 #include <string>
 
-#include "data_store.h"
+#include "storage.h"
 #include "mesh/mesh.h"
 #include "server_config.h"
 
@@ -21,7 +21,7 @@ nlohmann::json mesh_summary(const Mesh& mesh);
 
 class MeshService {
  public:
-  MeshService(DataStore& store, const ServerConfig& config);
+  MeshService(Storage& store, const ServerConfig& config);
   ~MeshService();
   Status start(std::vector<std::string>* report);
   Result<nlohmann::json> upload(std::span<const uint8_t> bytes, const std::string& name);

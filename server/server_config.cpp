@@ -16,6 +16,12 @@ Status ServerConfig::validate() const {
   if (host.empty()) return Status(StatusCode::kInvalidArgument, "must not be empty", "--host");
   if (port < 1 || port > 65535) return out_of_range("--port", "[1, 65535]");
   if (data_dir.empty()) return Status(StatusCode::kInvalidArgument, "must not be empty", "--data");
+  if (!storage.empty() && storage.rfind("s3://", 0) != 0)
+    return Status(StatusCode::kInvalidArgument, "must be s3://bucket[/prefix] (or leave it out and use --data DIR)", "--storage");
+  if (!storage.empty() && s3_endpoint.empty())
+    return Status(StatusCode::kInvalidArgument, "is required with --storage s3:// (e.g. http://127.0.0.1:7070)", "--s3-endpoint");
+  if (storage.empty() && !s3_endpoint.empty())
+    return Status(StatusCode::kInvalidArgument, "is only used with --storage s3://bucket/prefix", "--s3-endpoint");
   if (threads < 1 || threads > 256) return out_of_range("--threads", "[1, 256]");
   if (io_threads < 1 || io_threads > 64) return out_of_range("--io-threads", "[1, 64]");
   if (queue < 0 || queue > 10000) return out_of_range("--queue", "[0, 10000]");

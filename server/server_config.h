@@ -8,6 +8,7 @@
 #include "core/image_io.h"
 #include "mesh/mesh.h"
 #include "core/status.h"
+#include "storage.h"
 
 namespace solidtex::server {
 
@@ -15,6 +16,10 @@ struct ServerConfig {
   std::string host = "127.0.0.1";
   int port = 8080;                  // [1, 65535]
   std::string data_dir = "solidtex-data";
+  // --storage s3://bucket[/prefix]: keep data in an S3-compatible store instead of data_dir
+  // (storage.h, s3_storage.h); --s3-endpoint: its http(s)://host[:port]. Both or neither.
+  std::string storage;
+  std::string s3_endpoint;
   int threads = 2;                  // synthesis workers, [1, 256]
   int io_threads = 2;               // HTTP I/O threads, [1, 64]; they never synthesize
   int queue = 16;                   // synthesis requests waiting beyond the running ones, [0, 10000]; then 503
@@ -51,6 +56,7 @@ struct ServerConfig {
   std::string web_root;
 
   Status validate() const;
+  StorageConfig storage_config() const { return {data_dir, storage, s3_endpoint}; }
 };
 
 }  // namespace solidtex::server

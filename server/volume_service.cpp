@@ -123,7 +123,7 @@ json stats_json(const std::string& kind, const TargetSet& target, const std::vec
 }  // namespace
 
 struct VolumeService::Impl {
-  DataStore& store;
+  Storage& store;
   ServerConfig config;
   ExemplarService& exemplars;
   FieldService& fields;
@@ -140,7 +140,7 @@ struct VolumeService::Impl {
   bool stopping = false;
   std::thread sweeper;
 
-  Impl(DataStore& s, const ServerConfig& c, ExemplarService& e, FieldService& f, MeshService& m)
+  Impl(Storage& s, const ServerConfig& c, ExemplarService& e, FieldService& f, MeshService& m)
       : store(s), config(c), exemplars(e), fields(f), meshes(m) {}
   ~Impl() {
     {
@@ -261,8 +261,7 @@ struct VolumeService::Impl {
     if (field) st->field = std::move(field);
     else if (v.inline_field) st->field = v.inline_field;
     else {
-      SOLIDTEX_ASSIGN_OR_RETURN(auto stored, load_field(store.path(ResourceKind::kVolume, id, "field.stf")));
-      st->field = stored;
+      SOLIDTEX_ASSIGN_OR_RETURN(st->field, load_stored_field(id));
     }
     if (v.label && v.label->kind == RegionLabel::Kind::kSurfaceShell) {
       if (surface) {
@@ -472,12 +471,21 @@ struct VolumeService::Impl {
   // A volume.json read back (start-up, read-through); defined below.
   Result<std::shared_ptr<Volume>> load_stored(const std::string& id);
 
+  // The volume's own copy of its field (volumes/<id>/field.stf), decoded.
+  Result<std::shared_ptr<const QuatGridField>> load_stored_field(const std::string& id) const {
+    SOLIDTEX_ASSIGN_OR_RETURN(auto bytes, store.read(ResourceKind::kVolume, id, "field.stf", int64_t(1) << 30));
+    auto f = decode_field(bytes);
+    if (!f) return f.status().with_context("volume " + id + " field.stf");
+    return QuatGridField::create(f->origin, f->spacing, f->dims, f->nodes, f->log_scales);
+  }
+
   // The volume, read through the store (several replicas on one data directory): one created
-  // through another replica is loaded, one deleted through another is dropped (404).
+  // through another replica is loaded, one deleted through another is dropped (404). A failure
+  // of the store is returned as such, changing nothing.
   Result<std::shared_ptr<Volume>> find(const std::string& id) {
     auto missing = [&] { return Status(StatusCode::kNotFound, "no volume '" + id + "'", "id"); };
-    if (!DataStore::valid_id(id)) return missing();
-    const bool acknowledged = store.acknowledged(ResourceKind::kVolume, id);
+    if (!Storage::valid_id(id)) return missing();
+    SOLIDTEX_ASSIGN_OR_RETURN(const bool acknowledged, store.acknowledged(ResourceKind::kVolume, id));
     std::shared_ptr<VolumeState> dropped;
     {
       std::lock_guard<std::mutex> g(mutex);
@@ -494,6 +502,7 @@ struct VolumeService::Impl {
     }
     if (!acknowledged) return missing();
     auto v = load_stored(id);
+    if (!v && v.status().code() == StatusCode::kResourceExhausted) return v.status();  // the store's failure
     if (!v) {
       std::cerr << "solidtex serve: skipped volume " << id << ": " << v.status().to_string() << "\n";
       return missing();
@@ -503,9 +512,12 @@ struct VolumeService::Impl {
     if (inserted) touch(*it->second);
     return it->second;
   }
-  // Every volume of the store, and none that is gone from it.
+  // Every volume of the store, and none that is gone from it; what this replica knows when the
+  // store cannot be listed (VolumeService::list).
   void sync_all() {
-    std::vector<std::string> ids = store.ids(ResourceKind::kVolume);
+    auto listed = store.ids(ResourceKind::kVolume);
+    if (!listed) return;
+    std::vector<std::string> ids = std::move(*listed);
     {
       std::lock_guard<std::mutex> g(mutex);
       for (const auto& [id, v] : volumes)
@@ -515,7 +527,7 @@ struct VolumeService::Impl {
   }
 };
 
-VolumeService::VolumeService(DataStore& store, const ServerConfig& config, ExemplarService& exemplars,
+VolumeService::VolumeService(Storage& store, const ServerConfig& config, ExemplarService& exemplars,
                              FieldService& fields, MeshService& meshes)
     : impl_(std::make_unique<Impl>(store, config, exemplars, fields, meshes)) {}
 VolumeService::~VolumeService() = default;
@@ -571,18 +583,21 @@ Result<std::shared_ptr<Volume>> VolumeService::Impl::load_stored(const std::stri
   json desc;
   SOLIDTEX_ASSIGN_OR_RETURN(auto v, parse_spec(spec, nullptr, &desc));
   if (info["field"].value("kind", "") == "stored") {  // checked now, loaded at the first query
-    SOLIDTEX_RETURN_IF_ERROR(load_field(store.path(ResourceKind::kVolume, id, "field.stf")).status());
+    SOLIDTEX_RETURN_IF_ERROR(load_stored_field(id).status());
     v->inline_field = nullptr;
   }
-  if (v->label && v->label->kind == RegionLabel::Kind::kSurfaceShell && !store.exists(ResourceKind::kVolume, id, "mesh.source"))
+  SOLIDTEX_ASSIGN_OR_RETURN(const bool has_mesh, store.exists(ResourceKind::kVolume, id, "mesh.source"));
+  if (v->label && v->label->kind == RegionLabel::Kind::kSurfaceShell && !has_mesh)
     return Status(StatusCode::kCorrupt, "the volume's mesh copy is missing", "mesh.source");
   v->info = info;
   return v;
 }
 
 Status VolumeService::start(std::vector<std::string>* report) {
-  for (const std::string& id : impl_->store.ids(ResourceKind::kVolume)) {
+  SOLIDTEX_ASSIGN_OR_RETURN(std::vector<std::string> ids, impl_->store.ids(ResourceKind::kVolume));
+  for (const std::string& id : ids) {
     auto v = impl_->load_stored(id);
+    if (!v && v.status().code() == StatusCode::kResourceExhausted) return v.status();
     if (!v) {
       if (report) report->push_back("skipped volume " + id + ": " + v.status().to_string());
       continue;
@@ -616,7 +631,7 @@ Result<json> VolumeService::create(const std::string& spec_text) {
     SOLIDTEX_ASSIGN_OR_RETURN(mesh_bytes, impl_->store.read(ResourceKind::kMesh, mesh_id, "source.mesh"));
     SOLIDTEX_ASSIGN_OR_RETURN(surface, impl_->build_surface(*v, ms, mesh_bytes));
   }
-  const std::string id = DataStore::new_id("vol_");
+  const std::string id = Storage::new_id("vol_");
   SOLIDTEX_RETURN_IF_ERROR(impl_->store.create(ResourceKind::kVolume, id));
   v->info = {{"id", id},
              {"name", spec.value("name", "")},
@@ -627,9 +642,12 @@ Result<json> VolumeService::create(const std::string& spec_text) {
              {"seed", v->seed},
              {"params", v->params_spec},
              {"spec", spec}};
-  Status st = field_bytes.empty() ? Status::ok() : impl_->store.write(ResourceKind::kVolume, id, "field.stf", field_bytes);
-  if (st.is_ok() && !mesh_bytes.empty()) st = impl_->store.write(ResourceKind::kVolume, id, "mesh.source", mesh_bytes);
-  if (st.is_ok()) st = impl_->store.write_text(ResourceKind::kVolume, id, "volume.json", v->info.dump());
+  // Write-once, like every file of a volume: a fresh id, never rewritten.
+  Status st = field_bytes.empty() ? Status::ok()
+                                  : impl_->store.create_new(ResourceKind::kVolume, id, "field.stf", field_bytes).status();
+  if (st.is_ok() && !mesh_bytes.empty())
+    st = impl_->store.create_new(ResourceKind::kVolume, id, "mesh.source", mesh_bytes).status();
+  if (st.is_ok()) st = impl_->store.create_new_text(ResourceKind::kVolume, id, "volume.json", v->info.dump()).status();
   if (!st.is_ok()) {
     impl_->store.remove(ResourceKind::kVolume, id);
     return st;

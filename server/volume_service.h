@@ -27,7 +27,7 @@
 #include <string>
 #include <vector>
 
-#include "data_store.h"
+#include "storage.h"
 #include "exemplar_service.h"
 #include "field_service.h"
 #include "mesh_service.h"
@@ -54,7 +54,7 @@ struct VolumeStateTotals {
 
 class VolumeService {
  public:
-  VolumeService(DataStore& store, const ServerConfig& config, ExemplarService& exemplars, FieldService& fields,
+  VolumeService(Storage& store, const ServerConfig& config, ExemplarService& exemplars, FieldService& fields,
                 MeshService& meshes);
   ~VolumeService();
 
