@@ -40,13 +40,14 @@ class Cluster:
     """A running `scripts/cluster.sh up`; ``state`` is its cluster.json."""
 
     def __init__(self, directory: Path, replicas: int = 3, balance: str = "hash",
-                 storage: Optional[str] = None, serve_flags: str = "", timeout: float = 600) -> None:
+                 storage: Optional[str] = None, serve_flags: str = "", nginx_cache: str = "on",
+                 timeout: float = 600) -> None:
         self.dir = Path(directory)
         self.dir.mkdir(parents=True, exist_ok=True)
         self.port = free_base_port(replicas)
         env = dict(os.environ, CLUSTER_DIR=str(self.dir), CLUSTER_PORT=str(self.port),
                    CLUSTER_REPLICAS=str(replicas), CLUSTER_BALANCE=balance,
-                   CLUSTER_SERVE_FLAGS=serve_flags)
+                   CLUSTER_SERVE_FLAGS=serve_flags, CLUSTER_NGINX_CACHE=nginx_cache)
         if storage:
             env["CLUSTER_STORAGE"] = storage
         state_path = self.dir / "cluster.json"
