@@ -182,11 +182,14 @@ struct ExemplarService::Impl {
   // exemplar this replica has not seen (uploaded through another replica), drops one whose
   // directory is gone (deleted through another replica), takes up another replica's result,
   // and claims a job nobody works on (adopt_locked). Null: no such exemplar; an error: the
-  // store could not be read (nothing changed).
-  Result<Entry*> sync_locked(const std::string& id, std::vector<std::string>* report = nullptr) {
+  // store could not be read (nothing changed). `listed`: a listing just showed it acknowledged.
+  Result<Entry*> sync_locked(const std::string& id, std::vector<std::string>* report = nullptr, bool listed = false) {
     if (!Storage::valid_id(id)) return nullptr;
     auto it = entries.find(id);
-    SOLIDTEX_ASSIGN_OR_RETURN(const bool acknowledged, store.acknowledged(ResourceKind::kExemplar, id));
+    bool acknowledged = listed;
+    if (!acknowledged) {
+      SOLIDTEX_ASSIGN_OR_RETURN(acknowledged, store.acknowledged(ResourceKind::kExemplar, id));
+    }
     if (it != entries.end()) {
       Entry& e = it->second;
       if (!acknowledged) {  // deleted elsewhere
@@ -263,9 +266,10 @@ struct ExemplarService::Impl {
   // Every exemplar of the store, and none that is gone from it (mutex held); what this replica
   // knows when the store cannot be listed (ExemplarService::list).
   void sync_all_locked() {
-    auto ids = stored_and_loaded_ids(store, ResourceKind::kExemplar, entries);
-    if (ids)
-      for (const std::string& id : *ids) (void)sync_locked(id);
+    auto ids = ids_to_sync(store, ResourceKind::kExemplar, entries);
+    if (!ids) return;
+    for (const std::string& id : ids->listed) (void)sync_locked(id, nullptr, true);
+    for (const std::string& id : ids->unlisted) (void)sync_locked(id);
   }
 
   // `max_bytes` > 0: the analysis cost limit, checked as the images are decoded (uploads).
@@ -506,7 +510,7 @@ Status ExemplarService::start(std::vector<std::string>* report) {
   {
     std::lock_guard<std::mutex> g(impl_->mutex);
     SOLIDTEX_ASSIGN_OR_RETURN(std::vector<std::string> ids, impl_->store.ids(ResourceKind::kExemplar));
-    for (const std::string& id : ids) SOLIDTEX_RETURN_IF_ERROR(impl_->sync_locked(id, report).status());
+    for (const std::string& id : ids) SOLIDTEX_RETURN_IF_ERROR(impl_->sync_locked(id, report, true).status());
   }
   for (int i = 0; i < impl_->config.analysis_threads; ++i) impl_->threads.emplace_back([this] { impl_->worker(); });
   impl_->renewer = std::thread([this] { impl_->renew_loop(); });

@@ -198,10 +198,15 @@ struct FieldService::Impl {
   // replica. Null: no such field; an error: the store could not be read (nothing changed).
   // Changes of one field through two replicas at the same moment are serialised by the store:
   // revisions are write-once (write_revision), the later change answers 409.
-  Result<FieldEntry*> sync_locked(const std::string& id, std::vector<std::string>* report = nullptr) {
+  // `listed`: a listing just showed it acknowledged.
+  Result<FieldEntry*> sync_locked(const std::string& id, std::vector<std::string>* report = nullptr,
+                                  bool listed = false) {
     if (!Storage::valid_id(id)) return nullptr;
     auto it = entries.find(id);
-    SOLIDTEX_ASSIGN_OR_RETURN(bool acknowledged, store.acknowledged(ResourceKind::kField, id));
+    bool acknowledged = listed;
+    if (!acknowledged) {
+      SOLIDTEX_ASSIGN_OR_RETURN(acknowledged, store.acknowledged(ResourceKind::kField, id));
+    }
     if (!acknowledged) {
       if (it != entries.end()) entries.erase(it);
       return nullptr;
@@ -240,9 +245,10 @@ struct FieldService::Impl {
   }
   // A list shows what this replica knows when the store cannot be read (FieldService::list).
   void sync_all_locked() {
-    auto ids = stored_and_loaded_ids(store, ResourceKind::kField, entries);
-    if (ids)
-      for (const std::string& id : *ids) (void)sync_locked(id);
+    auto ids = ids_to_sync(store, ResourceKind::kField, entries);
+    if (!ids) return;
+    for (const std::string& id : ids->listed) (void)sync_locked(id, nullptr, true);
+    for (const std::string& id : ids->unlisted) (void)sync_locked(id);
   }
 };
 
@@ -252,7 +258,7 @@ FieldService::~FieldService() = default;
 Status FieldService::start(std::vector<std::string>* report) {
   std::lock_guard<std::mutex> g(impl_->mutex);
   SOLIDTEX_ASSIGN_OR_RETURN(std::vector<std::string> ids, impl_->store.ids(ResourceKind::kField));
-  for (const std::string& id : ids) SOLIDTEX_RETURN_IF_ERROR(impl_->sync_locked(id, report).status());
+  for (const std::string& id : ids) SOLIDTEX_RETURN_IF_ERROR(impl_->sync_locked(id, report, true).status());
   return Status::ok();
 }
 

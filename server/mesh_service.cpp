@@ -38,10 +38,14 @@ struct MeshService::Impl {
   // Read-through (mutex held; several replicas on one data directory): loads a mesh stored
   // through another replica, drops one deleted through another. False: no such mesh; an
   // error: the store could not be read.
-  Result<bool> sync_locked(const std::string& id, std::vector<std::string>* report = nullptr) {
+  // `listed`: a listing just showed it acknowledged.
+  Result<bool> sync_locked(const std::string& id, std::vector<std::string>* report = nullptr, bool listed = false) {
     if (!Storage::valid_id(id)) return false;
     auto it = meta.find(id);
-    SOLIDTEX_ASSIGN_OR_RETURN(bool acknowledged, store.acknowledged(ResourceKind::kMesh, id));
+    bool acknowledged = listed;
+    if (!acknowledged) {
+      SOLIDTEX_ASSIGN_OR_RETURN(acknowledged, store.acknowledged(ResourceKind::kMesh, id));
+    }
     if (!acknowledged) {
       if (it != meta.end()) meta.erase(it);
       decoded.erase(id);
@@ -60,9 +64,10 @@ struct MeshService::Impl {
   }
   // A list shows what this replica knows when the store cannot be read (MeshService::list).
   void sync_all_locked() {
-    auto ids = stored_and_loaded_ids(store, ResourceKind::kMesh, meta);
-    if (ids)
-      for (const std::string& id : *ids) (void)sync_locked(id);
+    auto ids = ids_to_sync(store, ResourceKind::kMesh, meta);
+    if (!ids) return;
+    for (const std::string& id : ids->listed) (void)sync_locked(id, nullptr, true);
+    for (const std::string& id : ids->unlisted) (void)sync_locked(id);
   }
 };
 
@@ -72,7 +77,7 @@ MeshService::~MeshService() = default;
 Status MeshService::start(std::vector<std::string>* report) {
   std::lock_guard<std::mutex> g(impl_->mutex);
   SOLIDTEX_ASSIGN_OR_RETURN(std::vector<std::string> ids, impl_->store.ids(ResourceKind::kMesh));
-  for (const std::string& id : ids) SOLIDTEX_RETURN_IF_ERROR(impl_->sync_locked(id, report).status());
+  for (const std::string& id : ids) SOLIDTEX_RETURN_IF_ERROR(impl_->sync_locked(id, report, true).status());
   return Status::ok();
 }
 

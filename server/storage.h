@@ -115,16 +115,20 @@ class Storage {
 
 std::span<const uint8_t> as_bytes(const std::string& text);
 
-// The ids a replica must look at to match the store: those stored now (sorted) followed by the
-// ones `loaded` (a map keyed by id) holds that the store no longer has (deleted elsewhere).
+// The ids a replica must look at to match the store, from one listing: `listed`, acknowledged
+// now (sorted; the listing says so, no need to ask about each again, which on S3 is a request
+// per id), and `unlisted`, the ones `loaded` (a map keyed by id) holds that the store no
+// longer lists (deleted elsewhere).
+struct IdsToSync {
+  std::vector<std::string> listed, unlisted;
+};
 template <typename LoadedMap>
-Result<std::vector<std::string>> stored_and_loaded_ids(const Storage& store, ResourceKind kind,
-                                                       const LoadedMap& loaded) {
-  SOLIDTEX_ASSIGN_OR_RETURN(std::vector<std::string> ids, store.ids(kind));
-  const size_t stored = ids.size();
+Result<IdsToSync> ids_to_sync(const Storage& store, ResourceKind kind, const LoadedMap& loaded) {
+  IdsToSync out;
+  SOLIDTEX_ASSIGN_OR_RETURN(out.listed, store.ids(kind));
   for (const auto& entry : loaded)
-    if (!std::binary_search(ids.begin(), ids.begin() + std::ptrdiff_t(stored), entry.first)) ids.push_back(entry.first);
-  return ids;
+    if (!std::binary_search(out.listed.begin(), out.listed.end(), entry.first)) out.unlisted.push_back(entry.first);
+  return out;
 }
 
 // Where `solidtex serve` keeps its data: --data DIR (local) or --storage s3://bucket/prefix

@@ -482,10 +482,14 @@ struct VolumeService::Impl {
   // The volume, read through the store (several replicas on one data directory): one created
   // through another replica is loaded, one deleted through another is dropped (404). A failure
   // of the store is returned as such, changing nothing.
-  Result<std::shared_ptr<Volume>> find(const std::string& id) {
+  // `listed`: a listing just showed it acknowledged.
+  Result<std::shared_ptr<Volume>> find(const std::string& id, bool listed = false) {
     auto missing = [&] { return Status(StatusCode::kNotFound, "no volume '" + id + "'", "id"); };
     if (!Storage::valid_id(id)) return missing();
-    SOLIDTEX_ASSIGN_OR_RETURN(const bool acknowledged, store.acknowledged(ResourceKind::kVolume, id));
+    bool acknowledged = listed;
+    if (!acknowledged) {
+      SOLIDTEX_ASSIGN_OR_RETURN(acknowledged, store.acknowledged(ResourceKind::kVolume, id));
+    }
     std::shared_ptr<VolumeState> dropped;
     {
       std::lock_guard<std::mutex> g(mutex);
@@ -515,15 +519,16 @@ struct VolumeService::Impl {
   // Every volume of the store, and none that is gone from it; what this replica knows when the
   // store cannot be listed (VolumeService::list).
   void sync_all() {
-    auto listed = store.ids(ResourceKind::kVolume);
+    auto listed = store.ids(ResourceKind::kVolume);  // outside the mutex: queries go on meanwhile
     if (!listed) return;
-    std::vector<std::string> ids = std::move(*listed);
+    std::vector<std::string> unlisted;
     {
       std::lock_guard<std::mutex> g(mutex);
       for (const auto& [id, v] : volumes)
-        if (!std::binary_search(ids.begin(), ids.end(), id)) ids.push_back(id);
+        if (!std::binary_search(listed->begin(), listed->end(), id)) unlisted.push_back(id);
     }
-    for (const std::string& id : ids) (void)find(id);
+    for (const std::string& id : *listed) (void)find(id, true);
+    for (const std::string& id : unlisted) (void)find(id);
   }
 };
 
