@@ -30,7 +30,7 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 
 # ---- configuration ------------------------------------------------------------------------
-storage=${CLUSTER_STORAGE:-dir}   # the storage every replica shares: dir | s3
+storage=${CLUSTER_STORAGE:-s3}   # the storage every replica shares: s3 | dir
 dir=$(mkdir -p "${CLUSTER_DIR:-$root/build/cluster}" && cd "${CLUSTER_DIR:-$root/build/cluster}" && pwd)
 port=${CLUSTER_PORT:-8090}
 replicas=${CLUSTER_REPLICAS:-3}
@@ -151,7 +151,10 @@ up() {
       store_json="{\"kind\": \"dir\", \"data\": \"$dir/data\"}" ;;
     s3)
       local key=solidtex secret=solidtex-secret
-      "$root/scripts/versitygw.sh" build >/dev/null
+      # Go's official tarball installs to /usr/local/go; a non-login shell may not have it on PATH.
+      command -v go >/dev/null || { [ -x /usr/local/go/bin/go ] && export PATH=/usr/local/go/bin:$PATH; } || true
+      "$root/scripts/versitygw.sh" build >/dev/null ||
+        { echo "cluster: cannot build versitygw (the S3 server); CLUSTER_STORAGE=dir runs without it" >&2; exit 1; }
       ROOT_ACCESS_KEY=$key ROOT_SECRET_KEY=$secret VERSITYGW_BUCKET=$s3_bucket \
         "$root/scripts/versitygw.sh" run "$s3_port" "$dir/s3" >"$dir/logs/s3.log" 2>&1 &
       pids+=($!)
