@@ -213,9 +213,10 @@ Ctrl-C stops the cluster.
 MSG
   # Serves until nginx ends or a signal arrives; a replica that dies (kill -9 in the cluster
   # test) leaves the others and nginx running.
-  wait "$nginx_pid" || true
-  echo "cluster: nginx exited" >&2
-  exit 1
+  local rc=0
+  wait "$nginx_pid" || rc=$?
+  echo "cluster: nginx exited (status $rc); stopping" >&2
+  exit "$rc"
 }
 
 case "${1:-up}" in
