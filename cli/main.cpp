@@ -26,6 +26,8 @@ constexpr const char* kUsage =
     "commands:\n"
     "  analyze IMAGE [--yz IMAGE --zx IMAGE] [--mask IMAGE] [--levels 4] [--neighborhood 9]\n"
     "          [--candidates 12] [--pca-dims 20] [--seed S] [--threads T] [--grain auto|none|x|y]\n"
+    "          [--search-k 24] [--knn-checks 192] [--balance-rounds 3] [--balance-box 24]\n"
+    "          [--balance-strength 0.025]\n"
     "          -o TABLE.stx [--json]\n"
     "  slice TABLE.stx (--axis x|y|z --at K [--origin U,V] | --plane OX,OY,OZ,UX,UY,UZ,VX,VY,VZ)\n"
     "          --size W,H [--scheme plain|subpass|grid|dual-grid] [--field identity|quat:W,X,Y,Z|FILE]\n"
@@ -36,13 +38,16 @@ constexpr const char* kUsage =
     "          [--cache-mb M] [--max-upload-mb M] [--max-image-side PX] [--max-voxels N] [--max-jobs N]\n"
     "          [--max-request-mb 1536] [--volume-state-mb 512] [--idle-evict-s 300] [--array-extent 1024]\n"
     "          [--chunk-cache-mb 64] [--web-root DIR] [--job-lease-seconds 30]\n"
+    "          [--storage s3://BUCKET/PREFIX --s3-endpoint URL]\n"
     "          --volume-state-mb bounds loaded volumes' tables, fields, bands and synthesizers (LRU\n"
     "          eviction); --idle-evict-s evicts volumes idle that long (0: never); --array-extent is\n"
     "          the side of the /zarr and /zarr2 arrays in finest voxels, --chunk-cache-mb keeps\n"
     "          their encoded chunks for repeated reads; --web-root is the browser app served at /\n"
     "          (default: the source tree's web/); --job-lease-seconds is how long an analysis job\n"
     "          stays claimed without renewal before another replica on the same --data takes it\n"
-    "          over; see README limits and \"Several replicas on one data directory\"\n"
+    "          over; see README limits and \"Several replicas on one data directory\"; --storage\n"
+    "          keeps the data in an S3-compatible store instead of --data (credentials from\n"
+    "          AWS_ACCESS_KEY_ID, AWS_SECRET_ACCESS_KEY, AWS_REGION; README \"Storage backends\")\n"
     "  exemplar KIND -o FILE.png [--size W,H] [--seed S]     KIND: wood, stripes, bricks, noise, spots, pebbles\n";
 
 }  // namespace
