@@ -1,5 +1,6 @@
 // solidtex analyze IMAGE [--yz IMAGE --zx IMAGE] [--mask IMAGE [--mask-yz IMAGE --mask-zx IMAGE]]
 //   [--mask-weight W] [--levels 4] [--neighborhood 9] [--candidates 12] [--pca-dims 20]
+//   [--search-k 24] [--knn-checks 192] [--balance-rounds 3] [--balance-box 24] [--balance-strength 0.025]
 //   [--seed S] [--threads T] [--grain auto|none|x|y] -o TABLE.stx [--json]
 #include <nlohmann/json.hpp>
 
@@ -32,7 +33,8 @@ Result<std::optional<ImageF>> optional_image(const Args& args, const std::string
 
 Status run_analyze(const std::vector<std::string>& argv) {
   Args args({"-o", "--yz", "--zx", "--mask", "--mask-yz", "--mask-zx", "--mask-weight", "--levels",
-             "--neighborhood", "--candidates", "--pca-dims", "--seed", "--threads", "--grain"},
+             "--neighborhood", "--candidates", "--pca-dims", "--search-k", "--knn-checks", "--seed", "--threads", "--grain",
+             "--balance-rounds", "--balance-box", "--balance-strength"},
             {"--json"});
   SOLIDTEX_RETURN_IF_ERROR(args.parse(argv));
   if (args.positionals().size() != 1)
@@ -46,7 +48,15 @@ Status run_analyze(const std::vector<std::string>& argv) {
   SOLIDTEX_ASSIGN_OR_RETURN(params.pca_dims, args.get_int("--pca-dims", params.pca_dims, 1, 64));
   SOLIDTEX_ASSIGN_OR_RETURN(int seed, args.get_int("--seed", 1, 0, 1 << 30));
   params.seed = uint32_t(seed);
-  params.search_k = std::max(params.search_k, params.candidates / 2 + 1);
+  SOLIDTEX_ASSIGN_OR_RETURN(params.search_k, args.get_int("--search-k", std::max(params.search_k, params.candidates / 2 + 1),
+                                                          params.candidates / 2 + 1, 64));
+  SOLIDTEX_ASSIGN_OR_RETURN(params.knn_checks, args.get_int("--knn-checks", params.knn_checks, 16, 100000));
+  UsageBalanceParams balance;
+  SOLIDTEX_ASSIGN_OR_RETURN(balance.rounds, args.get_int("--balance-rounds", balance.rounds, 0, 8));
+  SOLIDTEX_ASSIGN_OR_RETURN(balance.box, args.get_int("--balance-box", balance.box, 8, 64));
+  SOLIDTEX_ASSIGN_OR_RETURN(double strength, args.get_double("--balance-strength", balance.strength, 0, 1));
+  balance.strength = float(strength);
+  SOLIDTEX_RETURN_IF_ERROR(balance.validate());
   SOLIDTEX_RETURN_IF_ERROR(params.validate());
   SOLIDTEX_ASSIGN_OR_RETURN(int threads, args.get_int("--threads", 0, 0, 1024));
   set_thread_limit(threads);
@@ -72,7 +82,7 @@ Status run_analyze(const std::vector<std::string>& argv) {
   SOLIDTEX_ASSIGN_OR_RETURN(AnalysisResult result, analyze(exemplars, params, bar));
   // Usage penalties are calibrated by synthesis, so they are a step after analysis proper.
   const auto balance_start = std::chrono::steady_clock::now();
-  SOLIDTEX_ASSIGN_OR_RETURN(result.table, balance_usage(result.table, {}, bar));
+  SOLIDTEX_ASSIGN_OR_RETURN(result.table, balance_usage(result.table, balance, bar));
   const double balance_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - balance_start).count();
   const std::vector<uint8_t> bytes = encode_table(*result.table);
   SOLIDTEX_RETURN_IF_ERROR(write_file_atomic(out, bytes));
@@ -97,7 +107,9 @@ Status run_analyze(const std::vector<std::string>& argv) {
     j["levels"] = levels;
     j["params"] = {{"levels", params.levels},       {"neighborhood", params.neighborhood},
                    {"candidates", params.candidates}, {"pca_dims", params.pca_dims},
-                   {"search_k", params.search_k},     {"seed", params.seed}};
+                   {"search_k", params.search_k},     {"knn_checks", params.knn_checks},
+                   {"seed", params.seed},             {"balance_rounds", balance.rounds},
+                   {"balance_box", balance.box},      {"balance_strength", balance.strength}};
     std::cout << j.dump(2) << "\n";
   } else {
     std::cout << "wrote " << out << " (" << bytes.size() << " bytes) in " << result.seconds << " s + "

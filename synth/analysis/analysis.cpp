@@ -2,6 +2,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <future>
 #include <cmath>
 #include <mutex>
 
@@ -71,27 +72,38 @@ Result<AnalysisResult> analyze(const ExemplarSet& exemplars, const AnalysisParam
 
   std::vector<std::array<PcaBasis, 3>> pcas(static_cast<size_t>(L));
   std::vector<LevelCandidates> candidates(static_cast<size_t>(L));
-  // Work share per level grows with its... every level costs about the same: split evenly.
-  for (int l = 0; l < L; ++l) {
+  CandidateParams cp;
+  cp.neighborhood = n;
+  cp.candidates = params.candidates;
+  cp.search_k = params.search_k;
+  cp.knn.checks = params.knn_checks;
+  cp.knn.seed = params.seed;
+  auto level_stacks = [&](int l) {
+    PlaneStacks out{};
+    for (int k = 0; k < 3; ++k) out[k] = &stacks[exemplars.shared() ? 0 : k][size_t(L - 1 - l)];
+    return out;
+  };
+  // A level's serial part (PCA fit, crossbar lines, k-NN index builds) runs on its own thread
+  // while the previous level searches on the pool: it has no randomness of its own (FLANN is
+  // seeded per build, under its lock), so the table is the same bits as running it in line.
+  auto prepare = [&](int l) -> Result<CrossbarSearch> {
     const int spacing = stack_spacing(PyramidLevel{l}, L);
-    const int s = L - 1 - l;
-    PlaneStacks level_stacks{};
-    for (int k = 0; k < 3; ++k) level_stacks[k] = &stacks[exemplars.shared() ? 0 : k][size_t(s)];
+    const PlaneStacks ls = level_stacks(l);
     for (int k = 0; k < distinct; ++k) {
-      SOLIDTEX_ASSIGN_OR_RETURN(pcas[l][k], fit_level_pca(*level_stacks[k], n, spacing, params.pca_dims));
+      SOLIDTEX_ASSIGN_OR_RETURN(pcas[size_t(l)][k], fit_level_pca(*ls[k], n, spacing, params.pca_dims));
     }
-    if (distinct == 1) pcas[l][1] = pcas[l][2] = pcas[l][0];
-
-    CandidateParams cp;
-    cp.neighborhood = n;
-    cp.candidates = params.candidates;
-    cp.search_k = params.search_k;
-    cp.knn.checks = params.knn_checks;
-    cp.knn.seed = params.seed;
+    if (distinct == 1) pcas[size_t(l)][1] = pcas[size_t(l)][2] = pcas[size_t(l)][0];
+    return prepare_crossbar_search(ls, exemplars.shared(), spacing, cp, params.seed);
+  };
+  std::future<Result<CrossbarSearch>> next = std::async(std::launch::async, prepare, 0);
+  for (int l = 0; l < L; ++l) {
+    Result<CrossbarSearch> search = next.get();
+    if (l + 1 < L) next = std::async(std::launch::async, prepare, l + 1);
+    // On an error the next level's preparation is still joined (the future's destructor).
+    if (!search.is_ok()) return search.status();
     auto progress = [&](double f) { return sink.report((double(l) + f * 0.9) / double(L)); };
-    SOLIDTEX_ASSIGN_OR_RETURN(candidates[l], compute_level_candidates(level_stacks, exemplars.shared(), spacing, cp,
-                                                                      params.seed, progress));
-    measure_level_candidates(level_stacks, n, spacing, params.seed, candidates[l]);
+    SOLIDTEX_ASSIGN_OR_RETURN(candidates[size_t(l)], compute_level_candidates(*search, cp, progress));
+    measure_level_candidates(level_stacks(l), n, stack_spacing(PyramidLevel{l}, L), params.seed, candidates[size_t(l)]);
     if (sink.report(double(l + 1) / double(L))) return Status(StatusCode::kCancelled, "analysis cancelled");
   }
   SOLIDTEX_ASSIGN_OR_RETURN(auto table, Table::assemble(params, exemplars, std::move(pcas), std::move(candidates)));

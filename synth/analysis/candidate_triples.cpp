@@ -14,11 +14,7 @@ namespace {
 
 // Axes (0 = x, 1 = y, 2 = z) of each plane's first and second coordinate.
 
-// Crossbar line vectors of one image: row i holds pixel i's line.
-struct LineSet {
-  int width = 0, height = 0, dims = 0;
-  std::vector<float> first, second;
-};
+using LineSet = CrossbarSearch::Lines;
 
 LineSet build_lines(const ImageF& img, int n, int spacing) {
   LineSet s;
@@ -105,32 +101,47 @@ void measure_level_candidates(const PlaneStacks& stacks, int n, int spacing, uin
   level.random_crossbar_error = rsum / samples;
 }
 
-Result<LevelCandidates> compute_level_candidates(const PlaneStacks& stacks, bool shared, int spacing,
-                                                 const CandidateParams& params, uint32_t seed,
-                                                 const std::function<bool(double)>& progress) {
-  const int n = params.neighborhood;
-  const int nt = params.candidates;
-  const int keep = 2 * nt;
-  // Lines per distinct image.
-  std::array<LineSet, 3> lines;
+Result<CrossbarSearch> prepare_crossbar_search(const PlaneStacks& stacks, bool shared, int spacing,
+                                               const CandidateParams& params, uint32_t seed) {
+  CrossbarSearch search;
+  search.stacks = stacks;
+  search.shared = shared;
+  search.spacing = spacing;
   const int distinct = shared ? 1 : 3;
-  for (int k = 0; k < distinct; ++k) lines[k] = build_lines(*stacks[k], n, spacing);
-  auto lines_of = [&](int k) -> const LineSet& { return lines[shared ? 0 : k]; };
-  const int dims = lines[0].dims;
-
+  for (int k = 0; k < distinct; ++k) search.lines[k] = build_lines(*stacks[k], params.neighborhood, spacing);
+  const int dims = search.lines[0].dims;
   // Indices: first-axis lines and second-axis lines of each distinct image.
-  std::vector<KnnIndex> first_index, second_index;
   for (int k = 0; k < distinct; ++k) {
     KnnParams kp = params.knn;
     // Same seed for every plane: identical images then get identical indices (symmetry).
     kp.seed = params.knn.seed ^ (seed * 7919u + uint32_t(spacing));
-    SOLIDTEX_ASSIGN_OR_RETURN(auto fi, KnnIndex::build(lines[k].first.data(), stacks[k]->width * stacks[k]->height, dims, kp));
-    SOLIDTEX_ASSIGN_OR_RETURN(auto si, KnnIndex::build(lines[k].second.data(), stacks[k]->width * stacks[k]->height, dims, kp));
-    first_index.push_back(std::move(fi));
-    second_index.push_back(std::move(si));
+    const int count = stacks[k]->width * stacks[k]->height;
+    SOLIDTEX_ASSIGN_OR_RETURN(auto fi, KnnIndex::build(search.lines[k].first.data(), count, dims, kp));
+    SOLIDTEX_ASSIGN_OR_RETURN(auto si, KnnIndex::build(search.lines[k].second.data(), count, dims, kp));
+    search.first_index.push_back(std::move(fi));
+    search.second_index.push_back(std::move(si));
   }
-  auto index_of_first = [&](int k) -> const KnnIndex& { return first_index[shared ? 0 : k]; };
-  auto index_of_second = [&](int k) -> const KnnIndex& { return second_index[shared ? 0 : k]; };
+  return search;
+}
+
+Result<LevelCandidates> compute_level_candidates(const PlaneStacks& stacks, bool shared, int spacing,
+                                                 const CandidateParams& params, uint32_t seed,
+                                                 const std::function<bool(double)>& progress) {
+  SOLIDTEX_ASSIGN_OR_RETURN(CrossbarSearch search, prepare_crossbar_search(stacks, shared, spacing, params, seed));
+  return compute_level_candidates(search, params, progress);
+}
+
+Result<LevelCandidates> compute_level_candidates(const CrossbarSearch& search, const CandidateParams& params,
+                                                 const std::function<bool(double)>& progress) {
+  const PlaneStacks& stacks = search.stacks;
+  const bool shared = search.shared;
+  const int spacing = search.spacing;
+  const int nt = params.candidates;
+  const int keep = 2 * nt;
+  auto lines_of = [&](int k) -> const LineSet& { return search.lines[shared ? 0 : k]; };
+  const int dims = search.lines[0].dims;
+  auto index_of_first = [&](int k) -> const KnnIndex& { return search.first_index[shared ? 0 : k]; };
+  auto index_of_second = [&](int k) -> const KnnIndex& { return search.second_index[shared ? 0 : k]; };
 
   const int planes_to_search = shared ? 1 : 3;
   int64_t total_rows = 0;

@@ -67,7 +67,30 @@ double crossbar_error(const PlaneStacks& stacks, const CoordinateTriple& t, int 
 // Maps plane-xy candidates of a shared exemplar to plane `k`: out[j] = t[j - k].
 CoordinateTriple rotate_planes(const CoordinateTriple& t, int k);
 
+// The crossbar lines of one level's distinct images and their k-NN indices: the serial part of
+// a level's candidate search (FLANN builds one index at a time, under a process-wide lock), kept
+// apart so analysis can prepare the next level while this one searches on every thread.
+// Immutable once prepared; searching it is thread-safe. `stacks` must outlive it.
+struct CrossbarSearch {
+  struct Lines {
+    int width = 0, height = 0, dims = 0;
+    std::vector<float> first, second;  // row i: pixel i's first- and second-axis line
+  };
+  PlaneStacks stacks{};
+  bool shared = false;
+  int spacing = 1;
+  std::array<Lines, 3> lines;           // per distinct image
+  std::vector<KnnIndex> first_index;    // per distinct image: its first-axis lines
+  std::vector<KnnIndex> second_index;   // per distinct image: its second-axis lines
+};
+
+Result<CrossbarSearch> prepare_crossbar_search(const PlaneStacks& stacks, bool shared, int spacing,
+                                               const CandidateParams& params, uint32_t seed);
+
 // `progress(done_fraction)` is called from worker threads; returning true cancels.
+Result<LevelCandidates> compute_level_candidates(const CrossbarSearch& search, const CandidateParams& params,
+                                                 const std::function<bool(double)>& progress);
+// The same, preparing the search first.
 Result<LevelCandidates> compute_level_candidates(const PlaneStacks& stacks, bool shared, int spacing,
                                                  const CandidateParams& params, uint32_t seed,
                                                  const std::function<bool(double)>& progress);

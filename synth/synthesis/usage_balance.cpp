@@ -105,10 +105,16 @@ Result<std::vector<std::vector<CoordinateTriple>>> final_triples_by_level(const 
     constexpr int kMargin = 24;        // beyond any dependency halo at a level
     const Voxel lo{(min.x >> shift) - kMargin, (min.y >> shift) - kMargin, (min.z >> shift) - kMargin};
     const int side = ((box - 1) >> shift) + 2 + 2 * kMargin;
-    SOLIDTEX_ASSIGN_OR_RETURN(TargetSet region, TargetSet::box(lo, side, side, side));
+    // A plain list, not a TargetSet: its sort and sample index cost more than the lookup, and
+    // counts do not depend on the order.
+    std::vector<Voxel> region;
+    region.reserve(size_t(side) * side * side);
+    for (int x = 0; x < side; ++x)
+      for (int y = 0; y < side; ++y)
+        for (int z = 0; z < side; ++z) region.push_back({lo.x + x, lo.y + y, lo.z + z});
     std::vector<CoordinateTriple> triples;
     std::vector<uint8_t> found;
-    synth->cache().lookup(PyramidLevel{l}, region.voxels, triples, found);
+    synth->cache().lookup(PyramidLevel{l}, region, triples, found);
     for (size_t i = 0; i < triples.size(); ++i)
       if (found[i]) out[size_t(l)].push_back(triples[i]);
   }
