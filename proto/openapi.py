@@ -74,6 +74,13 @@ ZARR_CHUNK_OUT = {"description": "zstd-compressed chunk bytes; a strong ETag fro
 RANGE_OUT = {"206": {"description": "Partial content: the requested bytes of the 200 body (Range).", "headers": {**ARRAY_HEADERS, "Content-Range": STR}},
              "304": {"description": "Not modified: If-None-Match named the ETag; no body.", "headers": {**CORS, "ETag": STR, "Cache-Control": STR}},
              "416": {**err("Range not satisfiable: the range starts past the end (`Content-Range: bytes */total`)."), "headers": {**CORS, "Content-Range": STR}}}
+# Slices, cuts and regions: voxels are a pure function of (volume, request), so the answer is
+# immutable; its ETag hashes its bytes (server/api.cpp, Api::mark_immutable).
+IMMUTABLE_IMAGE = ("The answer is immutable: a strong ETag (\"img-\" and a hash of the body) and `Cache-Control: public, "
+                   "max-age=31536000, immutable`; deleting the volume does not reach caches that kept it.")
+IMAGE_RANGE_OUT = {"206": {"description": "Partial content: the requested bytes of the 200 body (Range).", "headers": {"ETag": STR, "Cache-Control": STR, "Content-Range": STR}},
+                   "304": {"description": "Not modified: If-None-Match named the ETag; no body.", "headers": {"ETag": STR, "Cache-Control": STR}},
+                   "416": {**err("Range not satisfiable: the range starts past the end (`Content-Range: bytes */total`)."), "headers": {"Content-Range": STR}}}
 def array_op(op_id, summary, ok, codes):
     return {"operationId": op_id, "summary": summary, "description": RANGED, "responses": {"200": ok, **RANGE_OUT, **errs(*codes)}}
 PRECOMPUTED_CHUNK = {"name": "chunk", "in": "path", "required": True, "description": "x0-x1_y0-y1_z0-z1 voxel bounds of the scale: inside it, at most 64 a side and 32768 voxels (else 404).", "schema": {"type": "string", "pattern": "^[0-9]+-[0-9]+_[0-9]+-[0-9]+_[0-9]+-[0-9]+$"}}
@@ -104,7 +111,7 @@ FIELD_OPS = ["get_field", "get_field_file", "sample_frames", "add_curve", "delet
 VOLUME_OPS = ["get_volume", "volume_stats", "slice", "cut", "region", "points", "surface", "delete_volume"]
 MESH_OPS = ["get_mesh", "get_mesh_file", "delete_mesh"]
 image_out = {"description": "The cut. PNG (8-bit sRGB) by default; with `Accept: application/octet-stream` raw sRGB8 bytes (H x W x 3, row-major) and with `Accept: application/octet-stream; dtype=float32` raw little-endian float32 linear RGB; raw answers carry `X-Shape: H,W,3` and `X-Dtype`.",
-    "headers": {"X-Shape": {"schema": {"type": "string"}}, "X-Dtype": {"schema": {"type": "string"}}, "X-Voxels-Synthesized": {"schema": {"type": "integer"}, "description": "Voxels this request synthesized over all levels (0 when everything was cached)."}},
+    "headers": {"ETag": STR, "Cache-Control": STR, "X-Shape": {"schema": {"type": "string"}}, "X-Dtype": {"schema": {"type": "string"}}, "X-Voxels-Synthesized": {"schema": {"type": "integer"}, "description": "Voxels this request synthesized over all levels (0 when everything was cached)."}},
     "content": {"image/png": {"schema": {"type": "string", "format": "binary"}}, "application/octet-stream": {"schema": {"type": "string", "format": "binary"}}}}
 revision_param = qp("revision", "The field revision this change is meant for (the one the client shows). When given and the field is at another revision (another client, or a retry, changed it since), the answer is 409 naming `revision` and saying the current one, and nothing changes. Absent: whatever revision is current.", integer(1, 2**31 - 1))
 REVISION_409 = ("`revision` was given and the field is at another revision: nothing changed (`field` is `revision`; the message says the current revision). "
@@ -248,7 +255,7 @@ paths = {
    "get": {"operationId": "web_file", "summary": "A file of the browser app; its Content-Type follows the extension (text/javascript for its ES modules).", "description": WEB_DESCRIPTION,
      "responses": {"200": {"description": "The file.", "headers": WEB_HEADERS, "content": {t: {"schema": {"type": "string", "format": "binary"}} for t in ("text/html", "text/javascript", "text/css", "application/json", "image/svg+xml", "image/png", "text/plain", "application/octet-stream")}},
                    **WEB_CONDITIONAL, **errs("400", "404", "422")}}},
- "/healthz": {"get": {"operationId": "healthz", "summary": "Liveness.", "responses": {"200": js({"type": "object", "required": ["status"], "properties": {"status": {"type": "string", "enum": ["ok", "stopping"]}, "queue_depth": {"type": "integer"}, "workers_busy": {"type": "integer"}}}), **errs("400")}}},
+ "/healthz": {"get": {"operationId": "healthz", "summary": "Liveness and readiness: 200 with status ok; 503 with status stopping once shutdown has begun, so balancers stop sending work.", "responses": {"200": js({"type": "object", "required": ["status"], "properties": {"status": {"type": "string", "enum": ["ok"]}, "queue_depth": {"type": "integer"}, "workers_busy": {"type": "integer"}}}), "503": js({"type": "object", "required": ["status"], "properties": {"status": {"type": "string", "enum": ["stopping"]}, "queue_depth": {"type": "integer"}, "workers_busy": {"type": "integer"}}}), **errs("400")}}},
  "/metrics": {"get": {"operationId": "metrics", "summary": "Prometheus text: requests and latency histograms per route, voxels synthesized, cache bytes and budget, queue depth, loaded volumes' state bytes and budget (solidtex_volume_state_bytes, solidtex_volume_state_budget_bytes, solidtex_volumes_loaded) and evictions by reason.", "responses": {"200": {"description": "OK", "content": {"text/plain": {"schema": {"type": "string"}}}}}}},
  "/v1/openapi.json": {"get": {"operationId": "openapi", "summary": "This document.", "responses": {"200": js({"type": "object"})}}},
  "/v1/exemplars": {
@@ -303,16 +310,19 @@ paths = {
      "parameters": [qp("axis", "x, y or z.", {"type": "string", "enum": ["x", "y", "z"]}, True), qp("at", "Voxel index along the axis.", integer(-MAX_COORD, MAX_COORD), True),
                     qlist("origin", "U,V (default 0,0), each in [-2^28, 2^28 - 2^24].", integer(-MAX_COORD, MAX_ORIGIN), 2),
                     qlist("size", "W,H, each in [1, 2^24].", integer(1, MAX_SIDE), 2, True), scale_param, timeout],
-     "responses": {"200": image_out, **errs("400", "404", "422", "503", "504")}}},
+     "description": IMMUTABLE_IMAGE + " " + RANGED,
+     "responses": {"200": image_out, **IMAGE_RANGE_OUT, **errs("400", "404", "422", "503", "504")}}},
  "/v1/volumes/{id}/cut": {"parameters": [pid()],
    "post": {"operationId": "cut", "summary": "Arbitrary planar cut: pixel (i, j) is the voxel of dataset `scale` (the finest voxels by default) nearest origin + i*u + j*v, all in that dataset's voxels.", "parameters": [scale_param, timeout],
      "requestBody": {"required": True, "content": {"application/json": {"schema": ref("Cut")}}},
+     "description": IMMUTABLE_IMAGE,
      "responses": {"200": image_out, **errs("400", "404", "413", "415", "422", "503", "504")}}},
  "/v1/volumes/{id}/region": {"parameters": [pid()],
    "get": {"operationId": "region", "summary": "A box of voxels; W*H*D at most --max-voxels (else 422). Default: an OpenVDB file with one Vec3s grid 'color' (linear RGB, index space = finest voxels). `Accept: application/octet-stream` gives raw sRGB8 (D x H x W x 3, x fastest), `; dtype=float32` raw linear float32.",
      "parameters": [qlist("min", "X,Y,Z voxel indices, each in [-2^28, 2^28 - 2^24].", integer(-MAX_COORD, MAX_ORIGIN), 3, True),
                     qlist("size", "W,H,D voxels, each in [1, 2^24].", integer(1, MAX_SIDE), 3, True), timeout],
-     "responses": {"200": {"description": "The voxels.", "headers": {"X-Shape": {"schema": {"type": "string"}}, "X-Dtype": {"schema": {"type": "string"}}, "X-Voxels-Synthesized": {"schema": {"type": "integer"}}},
+     "description": IMMUTABLE_IMAGE + " " + RANGED,
+     "responses": {**IMAGE_RANGE_OUT, "200": {"description": "The voxels.", "headers": {"X-Shape": {"schema": {"type": "string"}}, "X-Dtype": {"schema": {"type": "string"}}, "X-Voxels-Synthesized": {"schema": {"type": "integer"}}, "ETag": STR, "Cache-Control": STR},
                             "content": {"application/x-vdb": {"schema": {"type": "string", "format": "binary"}}, "application/octet-stream": {"schema": {"type": "string", "format": "binary"}}}}, **errs("400", "404", "422", "503", "504")}}},
  "/v1/volumes/{id}/points": {"parameters": [pid()],
    "post": {"operationId": "points", "summary": "Colors at world points (each rounded to its nearest finest voxel); at most --max-voxels points (else 422).", "parameters": [timeout],

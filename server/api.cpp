@@ -8,6 +8,7 @@
 #include "http_errors.h"
 #include "core/image_io.h"
 #include "api_json.h"
+#include "array_etag.h"
 #include "conditional_get.h"
 #include "core/json_fields.h"
 #include "openapi_document.h"
@@ -159,9 +160,10 @@ Status check_plane_weights(const std::vector<double>& w, const std::string& fiel
 }  // namespace
 
 Api::Api(const ServerConfig& config, ExemplarService& exemplars, FieldService& fields, VolumeService& volumes,
-         MeshService& meshes, Metrics& metrics, const WorkerPool& pool, const std::atomic<bool>& shutting_down)
+         MeshService& meshes, Metrics& metrics, const WorkerPool& pool, const std::atomic<bool>& stopping,
+         const std::atomic<bool>& shutting_down)
     : config_(config), exemplars_(exemplars), fields_(fields), volumes_(volumes), meshes_(meshes), metrics_(metrics), pool_(pool),
-      chunks_(config.chunk_cache_bytes), web_(config.web_root), shutting_down_(shutting_down) {}
+      chunks_(config.chunk_cache_bytes), web_(config.web_root), stopping_(stopping), shutting_down_(shutting_down) {}
 
 Result<std::unique_ptr<RequestInterrupter>> Api::interrupter_for(const HttpRequest& r, const std::optional<std::string>& timeout) const {
   double seconds = config_.deadline_s;
@@ -216,7 +218,9 @@ HttpResponse Api::web_file(const HttpRequest& r) { return static_file(r, r.param
 
 HttpResponse Api::healthz(const HttpRequest& r) {
   if (Status s = no_query(r); !s.is_ok()) return HttpResponse::error(s);
-  return HttpResponse::json(200, {{"status", shutting_down_.load() ? "stopping" : "ok"},
+  // 503 while stopping, so balancers and Kubernetes take the replica out before it goes.
+  const bool stopping = stopping_.load();
+  return HttpResponse::json(stopping ? 503 : 200, {{"status", stopping ? "stopping" : "ok"},
                                   {"queue_depth", pool_.queued()},
                                   {"workers_busy", pool_.running()}});
 }
@@ -457,7 +461,15 @@ Result<HttpResponse> Api::synthesize_image(const HttpRequest& r, const std::stri
   SOLIDTEX_ASSIGN_OR_RETURN(HttpResponse out,
                             encode_colors(q.rgb, target.width, target.height, shape, negotiate(r.accept, Encoding::kPng)));
   out.headers.push_back({"X-Voxels-Synthesized", std::to_string(q.voxels_synthesized)});
+  mark_immutable(out);
   return out;
+}
+
+void Api::mark_immutable(HttpResponse& out) {
+  // Voxels are a pure function of the volume, whose id is never reused, and the request: the
+  // same request always gets these bytes, so any HTTP cache (nginx in deploy/) may keep them.
+  out.headers.push_back({"ETag", "\"img-" + fnv1a_hex(out.body) + "\""});
+  out.headers.push_back({"Cache-Control", "public, max-age=31536000, immutable"});
 }
 
 HttpResponse Api::slice(const HttpRequest& r) {
@@ -477,7 +489,8 @@ HttpResponse Api::slice(const HttpRequest& r) {
     SOLIDTEX_RETURN_IF_ERROR(volumes_.check_target_size(sample_count(size), "size"));
     SOLIDTEX_ASSIGN_OR_RETURN(const int level, level_of_scale(r, q));
     SOLIDTEX_ASSIGN_OR_RETURN(TargetSet target, TargetSet::axis_cut(axis[0], int(at), origin[0], origin[1], size[0], size[1]));
-    return synthesize_image(r, "slice", target, q.get("timeout"), level);
+    SOLIDTEX_ASSIGN_OR_RETURN(HttpResponse out, synthesize_image(r, "slice", target, q.get("timeout"), level));
+    return conditional_get(r, std::move(out));
   }();
   return result ? *result : HttpResponse::error(result.status());
 }
@@ -528,7 +541,8 @@ HttpResponse Api::region(const HttpRequest& r) {
       SOLIDTEX_ASSIGN_OR_RETURN(out, encode_colors(qr->rgb, size[0], size[1] * size[2], shape, enc));
     }
     out.headers.push_back({"X-Voxels-Synthesized", std::to_string(qr->voxels_synthesized)});
-    return out;
+    mark_immutable(out);
+    return conditional_get(r, std::move(out));
   }();
   return result ? *result : HttpResponse::error(result.status());
 }
@@ -575,7 +589,8 @@ HttpResponse Api::points(const HttpRequest& r) {
     SOLIDTEX_ASSIGN_OR_RETURN(HttpResponse out,
                               encode_colors(qr->rgb, int(pts.size()), 1, std::to_string(pts.size()) + ",3", enc));
     out.headers.push_back({"X-Voxels-Synthesized", std::to_string(qr->voxels_synthesized)});
-    return out;
+    mark_immutable(out);
+    return conditional_get(r, std::move(out));
   }();
   return result ? *result : HttpResponse::error(result.status());
 }
@@ -692,7 +707,8 @@ HttpResponse Api::surface(const HttpRequest& r) {
     out.headers.push_back({"X-Target-Voxels", std::to_string(target.voxels.size())});
     out.headers.push_back({"X-Bounding-Voxels", std::to_string(bounding)});
     out.headers.push_back({"X-Voxels-Synthesized", std::to_string(qr->voxels_synthesized)});
-    return out;
+    mark_immutable(out);
+    return conditional_get(r, std::move(out));
   }();
   return result ? *result : HttpResponse::error(result.status());
 }

@@ -29,7 +29,8 @@ namespace solidtex::server {
 class Api {
  public:
   Api(const ServerConfig& config, ExemplarService& exemplars, FieldService& fields, VolumeService& volumes,
-      MeshService& meshes, Metrics& metrics, const WorkerPool& pool, const std::atomic<bool>& shutting_down);
+      MeshService& meshes, Metrics& metrics, const WorkerPool& pool, const std::atomic<bool>& stopping,
+      const std::atomic<bool>& shutting_down);
 
   // The browser app: GET / (index.html) and GET /web/{file} (static_files.h).
   HttpResponse web_index(const HttpRequest& r);
@@ -107,6 +108,8 @@ class Api {
   // synthesis level to pass to query_volume (-1 for scale 0, the finest); 404 past the coarsest.
   Result<int> level_of_scale(const HttpRequest& r, const QueryParams& q);
   HttpResponse array_metadata(const HttpRequest& r, const std::function<Result<nlohmann::json>(const ArrayView&)>& make);
+  // Adds a content ETag and `Cache-Control: immutable` to a synthesized answer (200 only).
+  static void mark_immutable(HttpResponse& out);
   Result<HttpResponse> synthesize_image(const HttpRequest& r, const std::string& kind, const TargetSet& target,
                                         const std::optional<std::string>& timeout, int level = -1);
 
@@ -119,7 +122,8 @@ class Api {
   const WorkerPool& pool_;
   ChunkCache chunks_;  // encoded array chunks by ETag (--chunk-cache-mb)
   StaticFiles web_;    // --web-root
-  const std::atomic<bool>& shutting_down_;
+  const std::atomic<bool>& stopping_;       // shutdown has begun: new work is refused, /healthz says 503
+  const std::atomic<bool>& shutting_down_;  // the grace period is over: running requests are interrupted
 };
 
 }  // namespace solidtex::server

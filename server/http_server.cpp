@@ -114,7 +114,7 @@ class Server {
     // thread's next request cannot reuse it, and the process grows by a request's working memory
     // per arena.
     pool_ = std::make_unique<WorkerPool>(config_.threads, config_.queue, [] { malloc_trim(0); });
-    api_ = std::make_unique<Api>(config_, *exemplars_, *fields_, *volumes_, *meshes_, metrics_, *pool_, abort_running_);
+    api_ = std::make_unique<Api>(config_, *exemplars_, *fields_, *volumes_, *meshes_, metrics_, *pool_, stopping_, abort_running_);
     SOLIDTEX_RETURN_IF_ERROR(fields_->start(&report));
     SOLIDTEX_RETURN_IF_ERROR(exemplars_->start(&report));
     SOLIDTEX_RETURN_IF_ERROR(meshes_->start(&report));

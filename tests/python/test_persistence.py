@@ -1,10 +1,13 @@
 """Persistence: everything acknowledged survives kill -9 and SIGTERM; leftovers are ignored."""
 import json
 import os
+import signal
+import threading
 import time
 
 import numpy as np
 import pytest
+import requests
 
 from support import ANALYSIS, ANALYSIS_CLI, run_cli, upload_ready
 
@@ -88,6 +91,36 @@ def test_sigterm_exits_cleanly_and_restarts(server, exemplars):
     b = server(data_dir=a.data_dir)
     assert b.client.get_exemplar(ex["id"])["state"] == "ready"
     assert np.array_equal(b.client.slice(vol["id"], "z", 1, (16, 16)), before)
+
+
+def test_healthz_says_stopping_with_503_during_shutdown(server, exemplars):
+    """Once SIGTERM arrives /healthz answers 503 "stopping" (balancers and Kubernetes take the
+    replica out) while running requests finish or reach their grace period."""
+    a = server()
+    ex = upload_ready(a.client, exemplars["stripes"])
+    vol = a.client.create_volume(exemplar=ex["id"], seed=3)
+    assert requests.get(f"{a.url}/healthz", timeout=10).status_code == 200
+    slow = threading.Thread(target=lambda: requests.get(
+        f"{a.url}/v1/volumes/{vol['id']}/slice", params={"axis": "z", "at": 0, "size": "2048,2048"}, timeout=60))
+    slow.start()
+    deadline = time.monotonic() + 20
+    while requests.get(f"{a.url}/healthz", timeout=10).json()["workers_busy"] == 0:
+        assert time.monotonic() < deadline, "the slow slice never started"
+        time.sleep(0.02)
+    a.proc.send_signal(signal.SIGTERM)
+    seen = None
+    while time.monotonic() < deadline:
+        try:
+            r = requests.get(f"{a.url}/healthz", timeout=10)
+        except requests.ConnectionError:
+            break
+        if r.status_code == 503:
+            seen = r.json()
+            break
+        time.sleep(0.02)
+    slow.join()
+    assert seen is not None and seen["status"] == "stopping", a.log()
+    assert a.proc.wait(15) == 0, a.log()
 
 
 def test_volumes_stored_before_a_default_changed_keep_their_voxels(server, exemplars):

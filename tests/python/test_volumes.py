@@ -269,3 +269,33 @@ def test_old_scheme_name_is_rejected_and_plain_works(shared, tmp_path):
     default = c.slice(shared.volume_id, "z", 3, (32, 24))
     assert not np.array_equal(png_pixels(png), default), "plain and dual-grid gave the same slice"
     c.delete_volume(vol["id"])
+
+
+def test_synthesized_answers_are_immutable_and_revalidate(shared):
+    """Slices, regions and cuts carry a content ETag and an immutable Cache-Control (HTTP caches,
+    nginx in deploy/, may keep them); a GET naming the ETag gets 304 without a body."""
+    base = f"{shared.server.url}/v1/volumes/{shared.volume_id}"
+    params = {"axis": "z", "at": 5, "size": "24,16"}
+    first = requests.get(f"{base}/slice", params=params, timeout=60)
+    again = requests.get(f"{base}/slice", params=params, timeout=60)
+    assert first.status_code == again.status_code == 200
+    etag = first.headers["ETag"]
+    assert etag.startswith('"img-') and etag == again.headers["ETag"]
+    assert first.headers["Cache-Control"] == "public, max-age=31536000, immutable"
+    other = requests.get(f"{base}/slice", params={**params, "at": 6}, timeout=60)
+    assert other.headers["ETag"] != etag
+    raw = requests.get(f"{base}/slice", params=params, headers={"Accept": "application/octet-stream"}, timeout=60)
+    assert raw.headers["ETag"] != etag  # another representation, another tag
+    revalidated = requests.get(f"{base}/slice", params=params, headers={"If-None-Match": etag}, timeout=60)
+    assert revalidated.status_code == 304 and revalidated.content == b""
+    assert revalidated.headers["ETag"] == etag
+    region = requests.get(f"{base}/region", params={"min": "0,0,0", "size": "4,4,4"},
+                          headers={"Accept": "application/octet-stream"}, timeout=60)
+    assert region.status_code == 200 and region.headers["ETag"].startswith('"img-')
+    assert requests.get(f"{base}/region", params={"min": "0,0,0", "size": "4,4,4"},
+                        headers={"Accept": "application/octet-stream", "If-None-Match": region.headers["ETag"]},
+                        timeout=60).status_code == 304
+    cut = requests.post(f"{base}/cut", json={"origin": [0, 0, 5], "u": [1, 0, 0], "v": [0, 1, 0], "size": [24, 16]},
+                        timeout=60)
+    assert cut.status_code == 200 and cut.headers["Cache-Control"].endswith("immutable")
+    assert cut.headers["ETag"] == etag  # the same voxels, the same PNG bytes
