@@ -12,7 +12,8 @@
    Each: closed loop (C threads back to back: answers per second) and open loop (a request
    every 1/RATE s whatever the answers; latency counted from when it was due, so queueing
    shows): p50/p99/max ms.
-2. A random walk of neighbouring cuts (64² slices: `at` +-1..2, panning +-16 voxels, one in
+2. A random walk of neighbouring cuts (--cut-size, 64² slices by default; 256² is what the
+   browser app asks for: `at` +-1..2, panning +-16 voxels, one in
    five steps back to a cut seen before) through 3 replicas, with consistent hashing and with
    round-robin, on cold replicas: nginx's hit rate (X-Cache-Status) and the replicas' voxel-
    cache hit rate (voxel lookups found / made, summed from each replica's
@@ -166,7 +167,7 @@ def measure_cached(args, data_dir: Path, volume: str, replicas: int, nginx_cache
 
 
 def walk(args, data_dir: Path, volume: str, balance: str, replicas: int = 3) -> Dict[str, Any]:
-    """The random walk of neighbouring 64x64 z cuts on cold replicas; hit rates per move kind."""
+    """The random walk of neighbouring z cuts (args.cut_size square) on cold replicas; hit rates per move kind."""
     rng = random.Random(args.seed)
     with Cluster(data_dir, replicas=replicas, balance=balance, storage=args.storage) as c:
         def counters() -> Tuple[int, int]:
@@ -201,7 +202,8 @@ def walk(args, data_dir: Path, volume: str, balance: str, replicas: int = 3) -> 
                 cut = (at, ou, ov)
                 seen.append(cut)
             t = time.monotonic()
-            r = requests.get(f"{c.url}/v1/volumes/{volume}/slice?axis=z&at={cut[0]}&origin={cut[1]},{cut[2]}&size=64,64",
+            n = args.cut_size
+            r = requests.get(f"{c.url}/v1/volumes/{volume}/slice?axis=z&at={cut[0]}&origin={cut[1]},{cut[2]}&size={n},{n}",
                              timeout=300)
             lat.append(time.monotonic() - t)
             assert r.status_code == 200, r.text[:200]
@@ -216,7 +218,8 @@ def walk(args, data_dir: Path, volume: str, balance: str, replicas: int = 3) -> 
             last = now
         wall = time.monotonic() - t0
         hits, lookups = last[0] - hits0, last[0] - hits0 + last[1] - misses0
-        return {"balance": balance, "replicas": replicas, "steps": args.walk_steps, "distinct_cuts": len(set(seen)),
+        return {"balance": balance, "replicas": replicas, "cut_size": args.cut_size, "steps": args.walk_steps,
+                "distinct_cuts": len(set(seen)),
                 "nginx_hit_rate": round(nginx_hits / args.walk_steps, 3),
                 "replica_voxel_cache_hit_rate": round(hits / max(1, lookups), 3),
                 "replica_voxel_lookups": lookups,
@@ -236,6 +239,7 @@ def main() -> None:
     ap.add_argument("--threads", type=int, default=4)
     ap.add_argument("--replicas", default="1,2,3")
     ap.add_argument("--walk-steps", type=int, default=150)
+    ap.add_argument("--cut-size", type=int, default=64, help="side of the walk's square z cuts, voxels")
     ap.add_argument("--walks", default="hash:3,round-robin:3,hash:1",
                     help="BALANCE:REPLICAS of each random walk (empty: none)")
     ap.add_argument("--seed", type=int, default=1)

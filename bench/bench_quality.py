@@ -16,7 +16,8 @@ origin, scored with ../shared/tools/texmetric.py (swd, coverage, energy, sharp; 
 energy alone rewards blur). Embark 2D (../shared/tools/embark-ref, built into BUILD/embark-ref
 with cargo on first use) synthesizes SIZE^2 from the same exemplar. Prints one JSON document
 with per-cut scores, per-exemplar worst-of-four swd over Embark's, and the issue's summary
-measures; writes a montage PNG per exemplar (exemplar | z | y | x | oblique | Embark) into DIR.
+measures; writes a montage PNG per exemplar (exemplar repeated at 1:1 | z | y | x | oblique |
+Embark) into DIR.
 """
 from __future__ import annotations
 
@@ -61,7 +62,13 @@ def embark_binary(build: Path) -> Path | None:
 
 
 def montage(paths: list[Path], out: Path, tile: int = 256) -> None:
+    """paths[0] is the exemplar: repeated at 1:1 to the cuts' size (a resized exemplar would show
+    its features at another scale than the cuts, one voxel being one exemplar pixel)."""
     images = [Image.open(p).convert("RGB") for p in paths]
+    cut = images[1].size if len(images) > 1 else images[0].size
+    ex = np.asarray(images[0])
+    reps = (-(-cut[1] // ex.shape[0]), -(-cut[0] // ex.shape[1]), 1)
+    images[0] = Image.fromarray(np.tile(ex, reps)[:cut[1], :cut[0]])
     images = [im.resize((tile, tile), Image.NEAREST) for im in images]
     sheet = Image.new("RGB", (len(images) * (tile + 4) - 4, tile), (255, 255, 255))
     for k, im in enumerate(images):
