@@ -162,6 +162,27 @@ class ServerFactory:
             s.stop()
 
 
+def small_exemplar(tmp_path: Path, kind: str, side: int) -> Path:
+    """A procedural `kind` exemplar of side x side pixels (solidtex exemplar), written once."""
+    path = tmp_path / f"{kind}{side}.png"
+    run_cli("exemplar", kind, "-o", path, "--size", f"{side},{side}")
+    return path
+
+
+def wait_job(client: Client, job_id: str, seconds: float = 60) -> Dict[str, Any]:
+    """The job once it has succeeded or failed, or as it is after `seconds`."""
+    end = time.monotonic() + seconds
+    while True:
+        job = client.get_job(job_id)
+        if job["state"] in ("succeeded", "failed") or time.monotonic() > end:
+            return job
+        time.sleep(0.1)
+
+
+def http_status(url: str) -> int:
+    return requests.get(url, timeout=30).status_code
+
+
 @contextlib.contextmanager
 def server_with_volume(base_dir: Path, image: Any, *flags: Any, seed: int,
                        name: Optional[str] = None) -> Iterator[SimpleNamespace]:

@@ -22,7 +22,7 @@ import numpy as np
 import pytest
 import requests
 
-from support import ANALYSIS, CUBE_OFF, REPO, free_port, run_cli, solidtex_bin
+from support import ANALYSIS, CUBE_OFF, REPO, free_port, http_status, small_exemplar, solidtex_bin, wait_job
 from solidtex_client import Client
 
 SCRIPT = REPO / "scripts" / "versitygw.sh"
@@ -134,25 +134,6 @@ def replicas(gateway, tmp_path):
         r.stop()
 
 
-def small_exemplar(tmp_path, kind, side):
-    path = tmp_path / f"{kind}{side}.png"
-    run_cli("exemplar", kind, "-o", path, "--size", f"{side},{side}")
-    return path
-
-
-def wait_job(client, job_id, seconds=90):
-    end = time.monotonic() + seconds
-    while True:
-        job = client.get_job(job_id)
-        if job["state"] in ("succeeded", "failed") or time.monotonic() > end:
-            return job
-        time.sleep(0.1)
-
-
-def status(url):
-    return requests.get(url, timeout=30).status_code
-
-
 def s3_object(gateway, key, body: bytes | None = None):
     """GET (body None) or PUT of one object with curl's own SigV4 signing: the test's view of
     the bucket, independent of the code under test."""
@@ -188,7 +169,7 @@ def test_two_replicas_on_one_bucket_behave_as_one_service(replicas, gateway, tmp
     ex_id, job_id = up["exemplar"]["id"], up["job"]["id"]
     # acknowledged by A: visible through B at once, analysed once (by A, whose lease B respects)
     assert b.client.get_exemplar(ex_id)["state"] == "analyzing"
-    assert wait_job(b.client, job_id)["state"] == "succeeded"
+    assert wait_job(b.client, job_id, seconds=90)["state"] == "succeeded"
     assert "took over" not in b.log(), b.log()
     ex_a, ex_b = a.client.get_exemplar(ex_id), b.client.get_exemplar(ex_id)
     assert ex_b["state"] == "ready" and ex_b["name"] == "shared", ex_b
@@ -226,10 +207,10 @@ def test_two_replicas_on_one_bucket_behave_as_one_service(replicas, gateway, tmp
     a.client.delete_mesh(mesh["id"])
     a.client.delete_exemplar(ex_id)
     for r in (b, c):
-        assert status(f"{r.url}/v1/volumes/{vol['id']}") == 404
-        assert status(f"{r.url}/v1/fields/{fld['id']}") == 404
-        assert status(f"{r.url}/v1/meshes/{mesh['id']}") == 404
-        assert status(f"{r.url}/v1/exemplars/{ex_id}") == 404
+        assert http_status(f"{r.url}/v1/volumes/{vol['id']}") == 404
+        assert http_status(f"{r.url}/v1/fields/{fld['id']}") == 404
+        assert http_status(f"{r.url}/v1/meshes/{mesh['id']}") == 404
+        assert http_status(f"{r.url}/v1/exemplars/{ex_id}") == 404
     with pytest.raises(subprocess.CalledProcessError):
         s3_object(gateway, f"{prefix}/exemplars/{ex_id}/meta.json")
 
@@ -258,7 +239,7 @@ def test_a_killed_replicas_analysis_is_taken_over_once_its_lease_expires(replica
         assert b.client.get_exemplar(ex_id)["state"] == "analyzing"
         time.sleep(0.2)
     assert "took over" not in b.log(), b.log()
-    job = wait_job(b.client, job_id)
+    job = wait_job(b.client, job_id, seconds=90)
     assert job["state"] == "succeeded", job
     assert f"took over the analysis of exemplar {ex_id}" in b.log(), b.log()
     with pytest.raises(subprocess.CalledProcessError):
@@ -278,7 +259,7 @@ def test_a_killed_replicas_analysis_on_this_host_is_taken_over_at_once(replicas,
         time.sleep(0.05)
     a.kill()
     t0 = time.monotonic()
-    assert wait_job(b.client, job_id)["state"] == "succeeded"
+    assert wait_job(b.client, job_id, seconds=90)["state"] == "succeeded"
     assert time.monotonic() - t0 < 60  # not the 600 s lease
     assert "took over" in b.log(), b.log()
 

@@ -11,31 +11,12 @@ import numpy as np
 import pytest
 import requests
 
-from support import ANALYSIS, CUBE_OFF, run_cli, solidtex_bin
+from support import ANALYSIS, CUBE_OFF, http_status, small_exemplar, solidtex_bin, wait_job
 
 SKETCH = {
     "domain": {"min": [0, 0, 0], "max": [32, 32, 32], "shortest_side_cells": 8},
     "curves": [{"points": [[4, 4, 16], [28, 28, 16]], "plane_normal": [0, 0, 1], "axis": "x"}],
 }
-
-
-def small_exemplar(tmp_path, kind, side):
-    path = tmp_path / f"{kind}{side}.png"
-    run_cli("exemplar", kind, "-o", path, "--size", f"{side},{side}")
-    return path
-
-
-def wait_job(client, job_id, seconds=60):
-    end = time.monotonic() + seconds
-    while True:
-        job = client.get_job(job_id)
-        if job["state"] in ("succeeded", "failed") or time.monotonic() > end:
-            return job
-        time.sleep(0.1)
-
-
-def status(url):
-    return requests.get(url, timeout=30).status_code
 
 
 def test_two_replicas_share_uploads_fields_meshes_volumes_and_deletions(server, tmp_path):
@@ -77,16 +58,16 @@ def test_two_replicas_share_uploads_fields_meshes_volumes_and_deletions(server, 
 
     # deleted through A: 404 through B (which had them loaded), and gone from B's lists
     a.client.delete_volume(vol["id"])
-    assert status(f"{b.url}/v1/volumes/{vol['id']}") == 404
-    assert status(f"{b.url}/v1/volumes/{vol['id']}/slice?axis=z&at=0&size=8,8") == 404
+    assert http_status(f"{b.url}/v1/volumes/{vol['id']}") == 404
+    assert http_status(f"{b.url}/v1/volumes/{vol['id']}/slice?axis=z&at=0&size=8,8") == 404
     assert vol["id"] not in [v["id"] for v in b.client.list_volumes()]
     a.client.delete_field(fld["id"])
     a.client.delete_mesh(mesh["id"])
-    assert status(f"{b.url}/v1/fields/{fld['id']}") == 404
-    assert status(f"{b.url}/v1/meshes/{mesh['id']}") == 404
+    assert http_status(f"{b.url}/v1/fields/{fld['id']}") == 404
+    assert http_status(f"{b.url}/v1/meshes/{mesh['id']}") == 404
     a.client.delete_exemplar(ex_id)
-    assert status(f"{b.url}/v1/exemplars/{ex_id}") == 404
-    assert status(f"{b.url}/v1/jobs/{job_id}") == 404
+    assert http_status(f"{b.url}/v1/exemplars/{ex_id}") == 404
+    assert http_status(f"{b.url}/v1/jobs/{job_id}") == 404
     assert ex_id not in [e["id"] for e in b.client.list_exemplars()]
 
 
