@@ -112,44 +112,6 @@ Status errno_status(const std::string& what, const std::string& path) {
   return Status(StatusCode::kIo, what + " '" + path + "': " + std::strerror(errno));
 }
 
-// A complete, fsync'd temporary file beside `target` with a name no other writer uses (the
-// pid alone is not enough: two threads of this process may race for one object).
-Result<std::string> write_temporary(const std::string& target, std::span<const uint8_t> bytes) {
-  static std::atomic<uint64_t> counter{0};
-  const fs::path t(target);
-  std::string name = ".";  // built by appending: GCC 12 warns falsely (-Wrestrict) about "." + std::string
-  name += t.filename().string();
-  name += ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter.fetch_add(1));
-  const std::string tmp = (t.parent_path() / name).string();
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
-  if (fd < 0) return errno_status("cannot create", tmp);
-  size_t off = 0;
-  while (off < bytes.size()) {
-    const ssize_t n = ::write(fd, bytes.data() + off, bytes.size() - off);
-    if (n < 0 && errno == EINTR) continue;
-    if (n < 0) {
-      Status st = errno_status("cannot write", tmp);
-      ::close(fd);
-      ::unlink(tmp.c_str());
-      return st;
-    }
-    off += size_t(n);
-  }
-  if (::fsync(fd) != 0 || ::close(fd) != 0) {
-    ::unlink(tmp.c_str());
-    return Status(StatusCode::kIo, "cannot sync '" + tmp + "'");
-  }
-  return tmp;
-}
-
-void sync_directory(const std::string& file) {
-  const int dfd = ::open(fs::path(file).parent_path().c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (dfd >= 0) {
-    ::fsync(dfd);
-    ::close(dfd);
-  }
-}
-
 Result<std::vector<uint8_t>> read_fd(int fd, const std::string& path, int64_t max_bytes) {
   struct stat st {};
   if (::fstat(fd, &st) != 0) return errno_status("cannot stat", path);
@@ -219,7 +181,7 @@ Result<std::string> DataStore::create_new(ResourceKind kind, const std::string& 
                                           std::span<const uint8_t> bytes) {
   if (!valid_id(id)) return Status(StatusCode::kInvalidArgument, "malformed id '" + id + "'", "id");
   const std::string target = path(kind, id, file);
-  SOLIDTEX_ASSIGN_OR_RETURN(std::string tmp, write_temporary(target, bytes));
+  SOLIDTEX_ASSIGN_OR_RETURN(std::string tmp, write_temporary_file(target, bytes));
   // link() never replaces: the name appears with its whole content, or not at all.
   const int rc = ::link(tmp.c_str(), target.c_str());
   const int err = errno;
@@ -229,7 +191,7 @@ Result<std::string> DataStore::create_new(ResourceKind kind, const std::string& 
     errno = err;
     return errno_status("cannot create", target);
   }
-  sync_directory(target);
+  sync_parent_directory(target);
   return etag_of(bytes);
 }
 
@@ -242,13 +204,13 @@ Result<std::string> DataStore::replace_if_match(ResourceKind kind, const std::st
     return st.code() == StatusCode::kNotFound ? etag_mismatch(target) : st;
   SOLIDTEX_ASSIGN_OR_RETURN(auto old, read_fd(current.fd(), target, int64_t(1) << 32));
   if (etag_of(old) != etag) return etag_mismatch(target);
-  SOLIDTEX_ASSIGN_OR_RETURN(std::string tmp, write_temporary(target, bytes));
+  SOLIDTEX_ASSIGN_OR_RETURN(std::string tmp, write_temporary_file(target, bytes));
   if (::rename(tmp.c_str(), target.c_str()) != 0) {
     Status st = errno_status("cannot replace", target);
     ::unlink(tmp.c_str());
     return st;
   }
-  sync_directory(target);
+  sync_parent_directory(target);
   return etag_of(bytes);
 }
 
@@ -261,7 +223,7 @@ Status DataStore::remove_if_match(ResourceKind kind, const std::string& id, cons
   SOLIDTEX_ASSIGN_OR_RETURN(auto old, read_fd(current.fd(), target, int64_t(1) << 32));
   if (etag_of(old) != etag) return etag_mismatch(target);
   if (::unlink(target.c_str()) != 0) return errno_status("cannot remove", target);
-  sync_directory(target);
+  sync_parent_directory(target);
   return Status::ok();
 }
 

@@ -1,5 +1,7 @@
 #include "core/byte_io.h"
 
+#include <atomic>
+
 #include <fcntl.h>
 #include <unistd.h>
 
@@ -23,19 +25,23 @@ uint64_t checksum64(std::span<const uint8_t> data) {
   return mix64(h ^ w);
 }
 
-Status write_file_atomic(const std::string& path, std::span<const uint8_t> bytes) {
+Result<std::string> write_temporary_file(const std::string& target, std::span<const uint8_t> bytes) {
   namespace fs = std::filesystem;
-  const fs::path target(path);
-  const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
-  const std::string tmp = (dir / ("." + target.filename().string() + ".tmp-" + std::to_string(::getpid()))).string();
-  int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) return Status(StatusCode::kIo, "cannot create '" + tmp + "': " + std::strerror(errno), "output");
+  static std::atomic<uint64_t> counter{0};
+  const fs::path t(target);
+  const fs::path dir = t.has_parent_path() ? t.parent_path() : fs::path(".");
+  std::string name = ".";  // built by appending: GCC 12 warns falsely (-Wrestrict) about "." + std::string
+  name += t.filename().string();
+  name += ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter.fetch_add(1));
+  const std::string tmp = (dir / name).string();
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+  if (fd < 0) return Status(StatusCode::kIo, "cannot create '" + tmp + "': " + std::strerror(errno));
   size_t off = 0;
   while (off < bytes.size()) {
-    ssize_t n = ::write(fd, bytes.data() + off, bytes.size() - off);
+    const ssize_t n = ::write(fd, bytes.data() + off, bytes.size() - off);
+    if (n < 0 && errno == EINTR) continue;
     if (n < 0) {
-      if (errno == EINTR) continue;
-      Status st(StatusCode::kIo, "cannot write '" + tmp + "': " + std::strerror(errno), "output");
+      Status st(StatusCode::kIo, "cannot write '" + tmp + "': " + std::strerror(errno));
       ::close(fd);
       ::unlink(tmp.c_str());
       return st;
@@ -44,18 +50,31 @@ Status write_file_atomic(const std::string& path, std::span<const uint8_t> bytes
   }
   if (::fsync(fd) != 0 || ::close(fd) != 0) {
     ::unlink(tmp.c_str());
-    return Status(StatusCode::kIo, "cannot sync '" + tmp + "'", "output");
+    return Status(StatusCode::kIo, "cannot sync '" + tmp + "'");
   }
-  if (::rename(tmp.c_str(), path.c_str()) != 0) {
-    Status st(StatusCode::kIo, "cannot rename to '" + path + "': " + std::strerror(errno), "output");
-    ::unlink(tmp.c_str());
-    return st;
-  }
-  int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  return tmp;
+}
+
+void sync_parent_directory(const std::string& file) {
+  namespace fs = std::filesystem;
+  const fs::path f(file);
+  const fs::path dir = f.has_parent_path() ? f.parent_path() : fs::path(".");
+  const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (dfd >= 0) {
     ::fsync(dfd);
     ::close(dfd);
   }
+}
+
+Status write_file_atomic(const std::string& path, std::span<const uint8_t> bytes) {
+  Result<std::string> tmp = write_temporary_file(path, bytes);
+  if (!tmp) return Status(tmp.status().code(), tmp.status().message(), "output");
+  if (::rename(tmp->c_str(), path.c_str()) != 0) {
+    Status st(StatusCode::kIo, "cannot rename to '" + path + "': " + std::strerror(errno), "output");
+    ::unlink(tmp->c_str());
+    return st;
+  }
+  sync_parent_directory(path);
   return Status::ok();
 }
 

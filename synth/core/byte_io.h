@@ -97,4 +97,12 @@ uint64_t checksum64(std::span<const uint8_t> data);
 // fsync of the directory. A crash leaves either the old file or the new one, never a mix.
 Status write_file_atomic(const std::string& path, std::span<const uint8_t> bytes);
 
+// A complete, fsync'd temporary file ".<name>.tmp-<pid>-<n>" beside `target`, created with
+// O_EXCL under a name no other writer uses (the pid alone is not enough: two threads of one
+// process may write one target at once). Returns its path; the caller renames or links it.
+Result<std::string> write_temporary_file(const std::string& target, std::span<const uint8_t> bytes);
+
+// fsync of the directory holding `file` (makes a rename or link into it durable); best effort.
+void sync_parent_directory(const std::string& file);
+
 }  // namespace solidtex
