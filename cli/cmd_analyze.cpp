@@ -1,7 +1,7 @@
 // solidtex analyze IMAGE [--yz IMAGE --zx IMAGE] [--mask IMAGE [--mask-yz IMAGE --mask-zx IMAGE]]
 //   [--mask-weight W] [--levels 4] [--neighborhood 9] [--candidates 12] [--pca-dims 20]
 //   [--search-k 24] [--knn-checks 192] [--balance-rounds 3] [--balance-box 24] [--balance-strength 0.025]
-//   [--seed S] [--threads T] [--grain auto|none|x|y] -o TABLE.stx [--json]
+//   [--seed S] [--threads T] [--grain auto|none|x|y|crossed] -o TABLE.stx [--json]
 #include <nlohmann/json.hpp>
 
 #include <chrono>

@@ -304,8 +304,8 @@ struct ExemplarService::Impl {
       auto img = decode_image(bytes, config.image_limits, name);
       if (!img) return as_upload_error(img.status());
       if (name.rfind("mask", 0) != 0) {
-        // grain x or y: xy in all planes (auto is known only after decoding; the full estimate follows)
-        pixels += img->pixel_count() * (name == "xy" && (grain == "x" || grain == "y") ? 3 : 1);
+        // grain x, y or crossed: xy in all planes (auto is known only after decoding; the full estimate follows)
+        pixels += img->pixel_count() * (name == "xy" && (grain == "x" || grain == "y" || grain == "crossed") ? 3 : 1);
         if (const int64_t at_least = pixels * per_pixel; max_bytes > 0 && at_least > max_bytes)
           return Status(StatusCode::kUnprocessable,
                         "analysing this exemplar needs at least " + std::to_string(at_least >> 20) + " MB; the limit is " +
@@ -552,7 +552,7 @@ Result<json> ExemplarService::upload(ExemplarUpload up) {
   AnalysisParams params = up.params;
   params.search_k = std::max(params.search_k, params.candidates / 2 + 1);
   SOLIDTEX_RETURN_IF_ERROR(params.validate());
-  // "auto" is resolved here, once: the stored grain is the layout applied ("", "x" or "y").
+  // "auto" is resolved here, once: the stored grain is the layout applied ("", "x", "y" or "crossed").
   std::string grain;
   SOLIDTEX_ASSIGN_OR_RETURN(ExemplarSet set, impl_->build_set(up.parts, up.grain, up.mask_weight, params,
                                                                impl_->config.max_request_bytes, &grain));

@@ -47,7 +47,7 @@ namespace solidtex::server {
 struct ExemplarUpload {
   std::string name;
   AnalysisParams params;
-  std::string grain = "auto";  // auto, none, x or y (exemplar.h: apply_grain_layout)
+  std::string grain = "auto";  // auto, none, x, y or crossed (exemplar.h: apply_grain_layout)
   float mask_weight = 1.0f;  // [0, 10]
   // Named parts: "xy" (required), "yz" and "zx" (both or neither), "mask", "mask_yz", "mask_zx".
   std::vector<std::pair<std::string, std::vector<uint8_t>>> parts;

@@ -49,6 +49,22 @@ Result<std::shared_ptr<const ImageF>> matching_image(const ImageF& rgb, const st
 
 }  // namespace
 
+namespace {
+
+bool is_crossed(const std::array<std::shared_ptr<const ImageF>, 3>& planes) {
+  if (planes[0] == planes[1]) return false;
+  const ImageF t = transposed(*planes[0]);
+  // A symmetric exemplar (E = E transposed) under a grain layout is not crossed: it keeps slabs.
+  if (t.width == planes[0]->width && t.pixels == planes[0]->pixels) return false;
+  for (int k = 1; k < 3; ++k)
+    if (planes[k]->width != t.width || planes[k]->height != t.height || planes[k]->channels != t.channels ||
+        planes[k]->pixels != t.pixels)
+      return false;
+  return true;
+}
+
+}  // namespace
+
 Result<ExemplarSet> ExemplarSet::create(ExemplarInputs in) {
   SOLIDTEX_RETURN_IF_ERROR(check_exemplar(in.xy, "xy"));
   if (in.yz.has_value() != in.zx.has_value())
@@ -80,6 +96,7 @@ Result<ExemplarSet> ExemplarSet::create(ExemplarInputs in) {
     SOLIDTEX_ASSIGN_OR_RETURN(auto zx, matching_image(*in.zx, in.mask_zx, in.mask_weight, "mask_zx"));
     set.planes_ = {xy, yz, zx};
   }
+  set.crossed_ = is_crossed(set.planes_);
   return set;
 }
 
@@ -95,6 +112,7 @@ Result<ExemplarSet> ExemplarSet::from_matching_images(std::array<std::shared_ptr
   ExemplarSet set;
   set.planes_ = std::move(planes);
   set.has_mask_ = has_mask;
+  set.crossed_ = is_crossed(set.planes_);
   return set;
 }
 
@@ -106,10 +124,17 @@ Result<std::string> apply_grain_layout(const std::string& grain, ExemplarInputs&
     if (in.yz || in.zx) return std::string();
     layout = auto_grain_layout(estimate_stripe_orientation(in.xy));
     if (layout.empty()) return layout;
-  } else if (grain != "x" && grain != "y") {
-    return Status(StatusCode::kInvalidArgument, "unknown grain '" + grain + "' (auto, none, x, y)", "grain");
+  } else if (grain != "x" && grain != "y" && grain != "crossed") {
+    return Status(StatusCode::kInvalidArgument, "unknown grain '" + grain + "' (auto, none, x, y, crossed)", "grain");
   }
   if (in.yz || in.zx) return Status(StatusCode::kInvalidArgument, "cannot be combined with yz/zx exemplars", "grain");
+  if (layout == "crossed") {
+    in.yz = transposed(in.xy);
+    in.zx = transposed(in.xy);
+    if (in.mask_xy) in.mask_yz = in.mask_zx = transposed(*in.mask_xy);
+    suggested_plane_weights = {1.f, 1.f, 1.f};
+    return layout;
+  }
   // The plane that holds both of the grain's cross axes shows end grain: E, down-weighted.
   const bool along_x = layout == "x";
   (along_x ? in.zx : in.yz) = transposed(in.xy);

@@ -38,7 +38,13 @@ struct ExemplarInputs {
 // "auto" (the default): "x" or "y" when the exemplar is strongly striped along that axis
 // (orientation.h: auto_grain_layout), isotropic otherwise, and isotropic whenever yz/zx
 // are given. "" and "none": isotropic, every plane the same exemplar.
-// Returns the layout applied: "", "x" or "y". Fails for an explicit layout with yz/zx.
+// "crossed": isotropic too, xy = E and yz = zx = E transposed. Plane k's second axis is plane
+// k+1's first axis, so with one image every crossbar matches the exemplar's vertical profiles
+// against its horizontal ones; crossed makes two of the three crossbars compare like with
+// like (no layout fixes all three), which keeps the structure of exemplars whose directions
+// differ (lit stones, brick courses, weaves: README, Quality). Three distinct images lose the
+// cyclic symmetry that lets analysis search one plane: about 3x the analysis time.
+// Returns the layout applied: "", "x", "y" or "crossed". Fails for an explicit layout with yz/zx.
 Result<std::string> apply_grain_layout(const std::string& grain, ExemplarInputs& inputs,
                                        std::array<float, 3>& suggested_plane_weights);
 
@@ -54,12 +60,16 @@ class ExemplarSet {
   const std::shared_ptr<const ImageF>& plane_ptr(Plane p) const { return planes_[index_of(p)]; }
   // True when one image is used for all three planes (then analysis exploits the symmetry).
   bool shared() const { return planes_[0] == planes_[1] && planes_[1] == planes_[2]; }
+  // The crossed layout (apply_grain_layout): yz and zx are xy transposed, pixel for pixel.
+  // An isotropic set like shared(); known from the images themselves, so stored tables say it too.
+  bool crossed() const { return crossed_; }
   bool has_mask() const { return has_mask_; }
   int channels() const { return planes_[0]->channels; }  // 3 or 4 (with mask)
 
  private:
   std::array<std::shared_ptr<const ImageF>, 3> planes_;
   bool has_mask_ = false;
+  bool crossed_ = false;
 };
 
 }  // namespace solidtex

@@ -70,6 +70,46 @@ TEST(GrainLayout, AutoLeavesIsotropicExemplarsAndThreeImageSetsAlone) {
   }
 }
 
+TEST(GrainLayout, CrossedGivesYzAndZxTheTransposedExemplar) {
+  std::array<float, 3> w{1.f, 0.5f, 1.f};
+  ExemplarInputs in;
+  in.xy = horizontal_stripes();
+  in.mask_xy = testing::procedural(ProceduralKind::kPebbles, in.xy.width, in.xy.height);
+  EXPECT_EQ(apply_grain_layout("crossed", in, w).value(), "crossed");
+  ASSERT_TRUE(in.yz && in.zx && in.mask_yz && in.mask_zx);
+  EXPECT_TRUE(same_pixels(*in.yz, transposed(in.xy)));
+  EXPECT_TRUE(same_pixels(*in.zx, transposed(in.xy)));
+  EXPECT_TRUE(same_pixels(*in.mask_yz, transposed(*in.mask_xy)));
+  EXPECT_TRUE(same_pixels(*in.mask_zx, transposed(*in.mask_xy)));
+  EXPECT_EQ(w, (std::array<float, 3>{1.f, 1.f, 1.f}));  // isotropic: no end grain
+  ExemplarInputs three;
+  three.xy = horizontal_stripes();
+  three.yz = three.xy;
+  three.zx = three.xy;
+  EXPECT_EQ(apply_grain_layout("crossed", three, w).status().field(), "grain");
+}
+
+// Synthesis resolves init auto to scatter for crossed sets (isotropic) and to slab for other
+// three-plane sets, so the set must recognise the layout, also when rebuilt from a table.
+TEST(GrainLayout, ExemplarSetsRecogniseTheCrossedLayout) {
+  auto set_for = [](const std::string& grain) {
+    ExemplarInputs in;
+    in.xy = testing::procedural(ProceduralKind::kBricks, 40, 32);
+    std::array<float, 3> w{1.f, 1.f, 1.f};
+    EXPECT_TRUE(apply_grain_layout(grain, in, w).is_ok());
+    return ExemplarSet::create(std::move(in)).value();
+  };
+  const ExemplarSet crossed = set_for("crossed");
+  EXPECT_TRUE(crossed.crossed());
+  EXPECT_FALSE(crossed.shared());
+  EXPECT_FALSE(set_for("none").crossed());
+  EXPECT_FALSE(set_for("x").crossed());
+  EXPECT_FALSE(set_for("y").crossed());
+  const auto rebuilt = ExemplarSet::from_matching_images(
+      {crossed.plane_ptr(Plane::kXY), crossed.plane_ptr(Plane::kYZ), crossed.plane_ptr(Plane::kZX)}, false);
+  EXPECT_TRUE(rebuilt.value().crossed());
+}
+
 TEST(GrainLayout, ErrorsNameTheGrain) {
   std::array<float, 3> w{1.f, 1.f, 1.f};
   ExemplarInputs in;

@@ -31,7 +31,8 @@ CoordinateTriple scatter_triple(const Table& table, const Voxel& v, uint32_t see
 
 Init resolved_init(const Table& table, Init init) {
   if (init != Init::kAuto) return init;
-  return table.exemplars().shared() ? Init::kScatter : Init::kSlab;
+  const ExemplarSet& e = table.exemplars();
+  return e.shared() || e.crossed() ? Init::kScatter : Init::kSlab;
 }
 
 CoordinateTriple init_triple(const Table& table, const Voxel& v, const Rot3& r, const SynthesisParams& params) {

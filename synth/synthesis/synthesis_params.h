@@ -31,8 +31,8 @@ enum class Scheme {
 
 // How the coarsest level's version 0 is made (pyramid_init.h).
 enum class Init {
-  kAuto,     // scatter for one shared exemplar (isotropic), slab for three planes (grain layouts,
-             // three images), each measured best there (README, Quality)
+  kAuto,     // scatter for one shared exemplar and for the crossed layout (isotropic), slab for
+             // three planes (grain layouts, three images), each measured best there (README, Quality)
   kSlab,     // Zhang §4.1: candidate slabs (exemplar xy thickened along z) tiled per subpart;
              // in isotropic solids it leaves streaks along z in x and y cuts that one fine pass
              // does not remove; with a grain along x its slabs are planks along the grain
