@@ -179,6 +179,14 @@ def wait_job(client: Client, job_id: str, seconds: float = 60) -> Dict[str, Any]
         time.sleep(0.1)
 
 
+def wait_job_running(client: Client, job_id: str, message: str, seconds: float = 30) -> None:
+    """Returns once the job is running; fails with `message` after `seconds`."""
+    end = time.monotonic() + seconds
+    while client.get_job(job_id)["state"] != "running":
+        assert time.monotonic() < end, message
+        time.sleep(0.05)
+
+
 def http_status(url: str) -> int:
     return requests.get(url, timeout=30).status_code
 

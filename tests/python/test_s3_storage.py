@@ -22,7 +22,7 @@ import numpy as np
 import pytest
 import requests
 
-from support import ANALYSIS, CUBE_OFF, REPO, free_port, http_status, small_exemplar, solidtex_bin, wait_job
+from support import ANALYSIS, CUBE_OFF, REPO, free_port, http_status, small_exemplar, solidtex_bin, wait_job, wait_job_running
 from solidtex_client import Client
 
 SCRIPT = REPO / "scripts" / "versitygw.sh"
@@ -221,10 +221,7 @@ def test_a_killed_replicas_analysis_is_taken_over_once_its_lease_expires(replica
     b = replicas("--job-lease-seconds", lease)
     up = a.client.upload_exemplar(small_exemplar(tmp_path, "spots", 48), name="orphan", **ANALYSIS)
     ex_id, job_id = up["exemplar"]["id"], up["job"]["id"]
-    end = time.monotonic() + 30
-    while a.client.get_job(job_id)["state"] != "running":
-        assert time.monotonic() < end, "the analysis never started on A"
-        time.sleep(0.05)
+    wait_job_running(a.client, job_id, "the analysis never started on A")
     a.kill()  # mid-analysis: no result.json, A's lease left in the bucket
     key = f"{replicas.prefix.split('/', 1)[1]}/exemplars/{ex_id}/lease"
     held = json.loads(s3_object(gateway, key))
@@ -253,10 +250,7 @@ def test_a_killed_replicas_analysis_on_this_host_is_taken_over_at_once(replicas,
     b = replicas("--job-lease-seconds", 600)
     up = a.client.upload_exemplar(small_exemplar(tmp_path, "spots", 48), name="orphan", **ANALYSIS)
     job_id = up["job"]["id"]
-    end = time.monotonic() + 30
-    while a.client.get_job(job_id)["state"] != "running":
-        assert time.monotonic() < end, "the analysis never started on A"
-        time.sleep(0.05)
+    wait_job_running(a.client, job_id, "the analysis never started on A")
     a.kill()
     t0 = time.monotonic()
     assert wait_job(b.client, job_id, seconds=90)["state"] == "succeeded"

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 import requests
 
-from support import ANALYSIS, CUBE_OFF, http_status, small_exemplar, solidtex_bin, wait_job
+from support import ANALYSIS, CUBE_OFF, http_status, small_exemplar, solidtex_bin, wait_job, wait_job_running
 
 SKETCH = {
     "domain": {"min": [0, 0, 0], "max": [32, 32, 32], "shortest_side_cells": 8},
@@ -77,10 +77,7 @@ def test_a_killed_replicas_analysis_is_finished_by_another_after_its_lease_expir
     b = server("--job-lease-seconds", lease, data_dir=a.data_dir)
     up = a.client.upload_exemplar(small_exemplar(tmp_path, "spots", 48), name="orphan", **ANALYSIS)
     ex_id, job_id = up["exemplar"]["id"], up["job"]["id"]
-    end = time.monotonic() + 30
-    while a.client.get_job(job_id)["state"] != "running":
-        assert time.monotonic() < end, "the analysis never started on A"
-        time.sleep(0.05)
+    wait_job_running(a.client, job_id, "the analysis never started on A")
     a.kill()  # mid-analysis: no result.json, A's lease left behind
     lease_path = a.data_dir / "exemplars" / ex_id / "lease"
     held = json.loads(lease_path.read_text())
