@@ -130,7 +130,7 @@ Result<std::string> apply_grain_layout(const std::string& grain, ExemplarInputs&
   if (in.yz || in.zx) return Status(StatusCode::kInvalidArgument, "cannot be combined with yz/zx exemplars", "grain");
   if (layout == "crossed") {
     in.yz = transposed(in.xy);
-    in.zx = transposed(in.xy);
+    in.zx = in.yz;
     if (in.mask_xy) in.mask_yz = in.mask_zx = transposed(*in.mask_xy);
     suggested_plane_weights = {1.f, 1.f, 1.f};
     return layout;
