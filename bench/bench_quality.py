@@ -6,6 +6,8 @@ Embark's 2D texture-synthesis on the same exemplar and size.
                   [--typicality T]   (synthesis' typicality weight; default: the CLI's default)
                   [--seeds 1,2,3]    (volume seeds; a single cut's swd varies by seed, so an
                                       exemplar's score is its worst-of-four swd averaged over them)
+                  [--analyze-args "--grain crossed"] (extra analyze flags, for the exemplars
+                                      not analysed with --grain x)
                   [--embark-cache F] (Embark's scores per exemplar and size, kept in F and reused:
                                       Embark takes minutes on the large exemplars)
 
@@ -87,6 +89,8 @@ def main() -> int:
     ap.add_argument("--table-cache", type=Path, default=None,
                     help="keep analysed tables here and reuse them (analysis dominates short runs)")
     ap.add_argument("--slice-args", default="", help="extra `solidtex slice` flags, e.g. \"--passes 1\"")
+    ap.add_argument("--analyze-args", default="",
+                    help="extra `solidtex analyze` flags for the exemplars analysed with defaults, e.g. \"--grain crossed\"")
     ap.add_argument("--seeds", default="1", help="comma-separated volume seeds")
     ap.add_argument("--embark-cache", type=Path, default=None)
     args = ap.parse_args()
@@ -113,14 +117,15 @@ def main() -> int:
         tmp = Path(tmp)
         for ex in exemplars:
             name = ex.stem
-            grain = ["--grain", "x"] if name in GRAIN_X else []
-            table = (args.table_cache or tmp) / f"{name}_grain_{'x' if grain else 'auto'}.stx"
+            grain = ["--grain", "x"] if name in GRAIN_X else shlex.split(args.analyze_args)
+            tag = "x" if name in GRAIN_X else ("auto" + ("_" + "_".join(a.strip("-") for a in grain) if grain else ""))
+            table = (args.table_cache or tmp) / f"{name}_grain_{tag}.stx"
             if not (args.table_cache and table.exists()):
                 table.parent.mkdir(parents=True, exist_ok=True)
                 run([solidtex, "analyze", ex, *grain, "-o", table])
             cuts = {"z": ["--axis", "z", "--at", "0"], "y": ["--axis", "y", "--at", "0"],
                     "x": ["--axis", "x", "--at", "0"], "oblique": ["--plane", OBLIQUE]}
-            entry = {"exemplar": name, "grain": "x" if grain else "", "size": n, "seeds": {}}
+            entry = {"exemplar": name, "grain": "x" if name in GRAIN_X else "", "analyze_args": [] if name in GRAIN_X else grain, "size": n, "seeds": {}}
             images = [ex]
             for seed in seeds:
                 per_seed = {}
@@ -168,7 +173,7 @@ def main() -> int:
     if ratios:
         summary.update({"median_worst_swd_over_embark": float(np.median(ratios)),
                         "max_worst_swd_over_embark": float(np.max(ratios))})
-    print(json.dumps({"size": n, "typicality": args.typicality, "slice_args": args.slice_args, "seeds": seeds,
+    print(json.dumps({"size": n, "typicality": args.typicality, "slice_args": args.slice_args, "analyze_args": args.analyze_args, "seeds": seeds,
                       "montages": str(out_dir), "exemplars": results, "summary": summary}, indent=1))
     return 0
 

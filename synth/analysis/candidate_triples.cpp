@@ -49,6 +49,8 @@ struct Scored {
   CoordinateTriple t;
 };
 
+bool by_error_then_triple(const Scored& u, const Scored& v) { return u.error < v.error || (u.error == v.error && u.t < v.t); }
+
 }  // namespace
 
 CoordinateTriple rotate_planes(const CoordinateTriple& t, int k) {
@@ -170,24 +172,38 @@ Result<LevelCandidates> compute_level_candidates(const CrossbarSearch& search, c
           const size_t p = size_t(y) * img.width + x;
           index_of_first(k1).search(&own.second[p * dims], params.search_k, qi, qd);
           index_of_second(k2).search(&own.first[p * dims], params.search_k, ri, rd);
+          // The best `keep` pairs by (error, triple), kept in a max-heap. k-NN distances come
+          // nearest first, and error = (qd[a] + rd[b]) + crossbar term >= qd[a] + rd[b] in
+          // floats, so once that bound exceeds the heap's worst, the rest of the row (and,
+          // at b = 0, every later row) cannot enter: the kept set is exactly the one a full
+          // sort of all search_k^2 pairs gives (a strict order: the pairs' triples differ).
           pairs.clear();
           for (size_t a = 0; a < qi.size(); ++a) {
             const float* q_second = &next.second[size_t(qi[a]) * dims];
             for (size_t b = 0; b < ri.size(); ++b) {
-              const float* r_first = &prev.first[size_t(ri[b]) * dims];
+              const float bound = qd[a] + rd[b];
+              if (pairs.size() == size_t(keep) && bound > pairs.front().error) {
+                if (b == 0) a = qi.size() - 1;  // every later row starts higher
+                break;
+              }
               Scored s;
-              s.error = qd[a] + rd[b] + sq_dist(q_second, r_first, dims);
+              s.error = bound + sq_dist(q_second, &prev.first[size_t(ri[b]) * dims], dims);
               s.t.at[k] = {x, y};
               s.t.at[k1] = pixel_of(qi[a], next.width);
               s.t.at[k2] = pixel_of(ri[b], prev.width);
-              pairs.push_back(s);
+              if (pairs.size() < size_t(keep)) {
+                pairs.push_back(s);
+                std::push_heap(pairs.begin(), pairs.end(), by_error_then_triple);
+              } else if (by_error_then_triple(s, pairs.front())) {
+                std::pop_heap(pairs.begin(), pairs.end(), by_error_then_triple);
+                pairs.back() = s;
+                std::push_heap(pairs.begin(), pairs.end(), by_error_then_triple);
+              }
             }
           }
-          const size_t m = std::min<size_t>(pairs.size(), size_t(keep));
-          std::partial_sort(pairs.begin(), pairs.begin() + m, pairs.end(), [](const Scored& u, const Scored& v) {
-            return u.error < v.error || (u.error == v.error && u.t < v.t);
-          });
-          std::copy(pairs.begin(), pairs.begin() + m, raw[k].begin() + p * keep);
+          std::sort_heap(pairs.begin(), pairs.end(), by_error_then_triple);
+          const size_t m = pairs.size();
+          std::copy(pairs.begin(), pairs.end(), raw[k].begin() + p * keep);
           raw_count[k][p] = uint8_t(m);
         }
         const int64_t done = rows_done.fetch_add(1) + 1;
