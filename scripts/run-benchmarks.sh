@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Runs every benchmark in bench/ and prints one JSON document:
-#   {"analysis": [...], "slice": {...}, "field": {...}, "surface": {...}, "service": {...},
-#    "arrays": {...}, "quality": {...}, "rss": {...}}. Takes about two hours on 2 cores (QUALITY_SIZE=128 for a quicker
+#   {"analysis": [...], "slice": {...}, "coherence": {...}, "field": {...}, "surface": {...},
+#    "service": {...}, "arrays": {...}, "quality": {...}, "rss": {...}}. Takes about two hours on 2 cores (QUALITY_SIZE=128 for a quicker
 #    quality run; RSS_QUICK=1 for smaller memory probes).
 # Uses ../shared/data/exemplars/wood_grain.png when present, else a procedural wood exemplar.
 set -euo pipefail
@@ -26,6 +26,8 @@ fi
 "$build/bin/solidtex" analyze "$exemplar" --grain x -o "$tmp/wood.stx" >/dev/null
 echo '"slice":'
 "$build/bin/bench_slice" "$tmp/wood.stx" $quick
+echo ', "coherence":'
+"$build/bin/bench_coherence" "$tmp/wood.stx"
 echo ', "field":'
 "$build/bin/bench_field"
 echo ', "surface":'
