@@ -1,6 +1,6 @@
 // Benchmark (diagnostic, issue #12): how coherent a cut's coordinate triples are, level by
 // level, and how far the three exemplar pixels of a finest triple agree. Prints one JSON object.
-//   bench_coherence TABLE.stx [--size N] [--typicality T] [--passes P]
+//   bench_coherence TABLE.stx [--size N] [--typicality T] [--passes P] [--finest-subpass-size S]
 // A z cut N x N (default 128) at z = 0, identity field, default parameters otherwise (the
 // table's suggested plane weights), synthesized twice: as configured, and with no correction
 // at the finer levels (upsampling only: the coarsest level's result carried down). Per level:
@@ -31,6 +31,7 @@ struct Options {
   int size = 128;
   float typicality = SynthesisParams{}.typicality;
   int passes = SynthesisParams{}.passes;
+  int finest_subpass_size = SynthesisParams{}.finest_subpass_size;
 };
 
 // Steps of each plane's coordinate when moving one voxel along world x or y (a z cut's axes):
@@ -128,9 +129,10 @@ int main(int argc, char** argv) {
     if (a == "--size" && has_value) o.size = std::atoi(argv[++i]);
     else if (a == "--typicality" && has_value) o.typicality = float(std::atof(argv[++i]));
     else if (a == "--passes" && has_value) o.passes = std::atoi(argv[++i]);
+    else if (a == "--finest-subpass-size" && has_value) o.finest_subpass_size = std::atoi(argv[++i]);
     else if (o.table.empty() && a.rfind("--", 0) != 0) o.table = a;
     else {
-      std::cerr << "usage: bench_coherence TABLE.stx [--size N] [--typicality T] [--passes P]\n";
+      std::cerr << "usage: bench_coherence TABLE.stx [--size N] [--typicality T] [--passes P] [--finest-subpass-size S]\n";
       return 2;
     }
   }
@@ -149,6 +151,7 @@ int main(int argc, char** argv) {
     p.plane_weights = (*table)->params().suggested_plane_weights;
     p.typicality = o.typicality;
     p.passes = corrected ? o.passes : 0;
+    p.finest_subpass_size = o.finest_subpass_size;
     if (Status s = p.validate(); !s.is_ok()) {
       std::cerr << s.to_string() << "\n";
       return 2;
@@ -165,7 +168,7 @@ int main(int argc, char** argv) {
       return 1;
     }
     out[corrected ? "corrected" : "upsampled_only"] = {
-        {"passes", p.passes}, {"typicality", p.typicality},
+        {"passes", p.passes}, {"typicality", p.typicality}, {"finest_subpass_size", p.finest_subpass_size},
         {"levels", measure(**table, (*synth)->cache(), o.size, normalised_weights(p.plane_weights))}};
   }
   std::cout << out.dump() << "\n";
