@@ -13,12 +13,17 @@
 //
 // When one image serves all three planes the problem is symmetric under cyclic rotation of the
 // planes, so only plane xy is searched and planes yz, zx are its rotations (exactly equal to
-// searching them). Deterministic: fixed seeds, per-pixel work written to fixed slots.
+// searching them). When a plane's image is another's transposed (the crossed layout: E, E^T,
+// E^T; analysis.cpp says why the grain layouts do not use it), its first-axis lines are that image's second-axis lines, so
+// the planes share line sets, k-NN indices and whole searches: a layout of E and E^T needs
+// 2 indices and 4 searches of every pixel instead of 6 and 6. Deterministic: fixed seeds,
+// per-pixel work written to fixed slots.
 #pragma once
 
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -61,6 +66,21 @@ struct LevelCandidates {
 
 using PlaneStacks = std::array<const ImageF*, 3>;  // one matching image per plane, same channels
 
+// Where a plane's crossbar lines come from: plane `base`'s image (base <= the plane's index),
+// transposed or not. {0,F},{0,F},{0,F} is one shared image; {0,F},{1,F},{2,F} three images.
+struct PlaneSource {
+  int base = 0;
+  bool transposed = false;
+  friend bool operator==(const PlaneSource&, const PlaneSource&) = default;
+};
+using PlaneLayout = std::array<PlaneSource, 3>;
+inline constexpr PlaneLayout kSharedLayout{{{0, false}, {0, false}, {0, false}}};
+inline constexpr PlaneLayout kDistinctLayout{{{0, false}, {1, false}, {2, false}}};
+// The layout of three exemplar images: a plane equal to plane 0's image, pixel for pixel, or to
+// its transpose, shares plane 0's lines; any other plane has its own. Planes 1 and 2 equal to
+// each other but unrelated to plane 0 keep their own lines (rare: no layout makes them).
+PlaneLayout plane_layout(const std::array<const ImageF*, 3>& images);
+
 // Mean squared difference per crossbar sample and channel.
 double crossbar_error(const PlaneStacks& stacks, const CoordinateTriple& t, int n, int spacing);
 
@@ -77,20 +97,26 @@ struct CrossbarSearch {
     std::vector<float> first, second;  // row i: pixel i's first- and second-axis line
   };
   PlaneStacks stacks{};
-  bool shared = false;
+  PlaneLayout layout = kDistinctLayout;
+  bool shared = false;                  // layout == kSharedLayout
   int spacing = 1;
-  std::array<Lines, 3> lines;           // per distinct image
-  std::vector<KnnIndex> first_index;    // per distinct image: its first-axis lines
-  std::vector<KnnIndex> second_index;   // per distinct image: its second-axis lines
+  std::array<Lines, 3> lines;           // per base image (index = base; others empty)
+  std::array<std::optional<KnnIndex>, 3> first_index;   // per base image: its first-axis lines
+  std::array<std::optional<KnnIndex>, 3> second_index;  // per base image: its second-axis lines
 };
 
-Result<CrossbarSearch> prepare_crossbar_search(const PlaneStacks& stacks, bool shared, int spacing,
+// The lines of a base plane are built from stacks[base]; a transposed plane's from its base's.
+Result<CrossbarSearch> prepare_crossbar_search(const PlaneStacks& stacks, const PlaneLayout& layout, int spacing,
                                                const CandidateParams& params, uint32_t seed);
 
 // `progress(done_fraction)` is called from worker threads; returning true cancels.
 Result<LevelCandidates> compute_level_candidates(const CrossbarSearch& search, const CandidateParams& params,
                                                  const std::function<bool(double)>& progress);
 // The same, preparing the search first.
+Result<LevelCandidates> compute_level_candidates(const PlaneStacks& stacks, const PlaneLayout& layout, int spacing,
+                                                 const CandidateParams& params, uint32_t seed,
+                                                 const std::function<bool(double)>& progress);
+// `shared`: kSharedLayout, else kDistinctLayout.
 Result<LevelCandidates> compute_level_candidates(const PlaneStacks& stacks, bool shared, int spacing,
                                                  const CandidateParams& params, uint32_t seed,
                                                  const std::function<bool(double)>& progress);

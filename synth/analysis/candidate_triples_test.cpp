@@ -203,6 +203,38 @@ TEST(CandidateTriples, ThreeDifferentExemplarsAndMasksWork) {
       << level->mean_crossbar_error << " vs " << level->random_crossbar_error;
 }
 
+TEST(CandidateTriples, PlaneLayoutFindsTransposedPlanes) {
+  const ImageF e = testing::procedural(ProceduralKind::kNoise, 24, 18);
+  const ImageF et = transposed(e);
+  const ImageF copy = e;
+  const ImageF other = testing::procedural(ProceduralKind::kWood, 24, 18);
+  EXPECT_EQ(plane_layout({&e, &e, &e}), kSharedLayout);
+  EXPECT_EQ(plane_layout({&e, &copy, &copy}), kSharedLayout);  // equal pixels, distinct objects
+  EXPECT_EQ(plane_layout({&e, &et, &et}), (PlaneLayout{{{0, false}, {0, true}, {0, true}}}));  // crossed
+  EXPECT_EQ(plane_layout({&e, &copy, &et}), (PlaneLayout{{{0, false}, {0, false}, {0, true}}}));  // grain x
+  EXPECT_EQ(plane_layout({&e, &other, &et}), (PlaneLayout{{{0, false}, {1, false}, {0, true}}}));
+  EXPECT_EQ(plane_layout({&e, &other, &other}), kDistinctLayout);
+}
+
+TEST(CandidateTriples, TransposedPlanesSharingSearchesEqualSearchingEachPlane) {
+  // With exact k-NN (checks above the pixel count), sharing E's lines and searches with the
+  // planes that hold E transposed finds the same triples as searching those planes' own lines:
+  // a transposed image's first-axis lines are its original's second-axis lines, float for float.
+  const ImageF e = testing::procedural(ProceduralKind::kNoise, 22, 18, 7);
+  const ImageF et = transposed(e);
+  CandidateParams p = small_params();
+  p.knn.checks = 100000;
+  for (const PlaneStacks& stacks : {PlaneStacks{&e, &et, &et}, PlaneStacks{&e, &e, &et}, PlaneStacks{&e, &et, &e}}) {
+    const PlaneLayout layout = plane_layout(stacks);
+    ASSERT_NE(layout, kDistinctLayout);
+    auto shared = compute_level_candidates(stacks, layout, 2, p, 3, nullptr);
+    auto separate = compute_level_candidates(stacks, kDistinctLayout, 2, p, 3, nullptr);
+    ASSERT_TRUE(shared.is_ok() && separate.is_ok());
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(shared->planes[k], separate->planes[k]) << "plane " << k;
+    EXPECT_EQ(shared->coherent_fraction, separate->coherent_fraction);
+  }
+}
+
 TEST(CandidateTriples, CancellationStopsTheSearch) {
   ImageF img = testing::procedural(ProceduralKind::kNoise, 32, 32);
   auto r = compute_level_candidates({&img, &img, &img}, true, 1, small_params(), 1, [](double) { return true; });
