@@ -39,7 +39,9 @@ from urllib.parse import urlsplit
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "tests" / "cluster"))
+sys.path.insert(0, str(REPO / "bench"))
 from harness import Cluster  # noqa: E402
+from http_bench import percentile, run_threads  # noqa: E402
 
 import requests  # noqa: E402
 
@@ -51,8 +53,8 @@ def load() -> List[float]:
 
 
 def pct(values: List[float], p: float) -> float:
-    v = sorted(values)
-    return round(v[min(len(v) - 1, int(round(p / 100 * (len(v) - 1))))] * 1000, 2) if v else float("nan")
+    """The p-th percentile of `values` (seconds) in milliseconds; NaN when there are none."""
+    return round(percentile(values, p) * 1000, 2) if values else float("nan")
 
 
 class Conn(threading.local):
@@ -94,13 +96,7 @@ def closed_loop(url: str, paths: List[str], threads: int, seconds: float) -> Dic
             lat.extend(mine)
             errors[0] += bad
 
-    t0 = time.monotonic()
-    ts = [threading.Thread(target=worker, args=(k,)) for k in range(threads)]
-    for t in ts:
-        t.start()
-    for t in ts:
-        t.join()
-    wall = time.monotonic() - t0
+    wall = run_threads(threads, worker)
     return {"threads": threads, "requests": len(lat), "per_second": round(len(lat) / wall, 1),
             "p50_ms": pct(lat, 50), "p99_ms": pct(lat, 99), "errors": errors[0]}
 

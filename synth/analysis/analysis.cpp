@@ -70,11 +70,7 @@ Result<AnalysisResult> analyze(const ExemplarSet& exemplars, const AnalysisParam
   // would change in near-ties (lines from E's stack round differently from E^T's own), and the
   // sketched-ring grain test sits at its threshold on seed 1 (9.9 -> 10.5 degrees; over 3 x 5
   // seeds 9.3 -> 9.6, within noise): grain x/y keep their table bits, searched per plane.
-  const PlaneLayout layout =
-      exemplars.shared() ? kSharedLayout
-      : exemplars.crossed()
-          ? plane_layout({&exemplars.plane(Plane::kXY), &exemplars.plane(Plane::kYZ), &exemplars.plane(Plane::kZX)})
-          : kDistinctLayout;
+  const PlaneLayout layout = exemplars.shared() ? kSharedLayout : exemplars.crossed() ? kCrossedLayout : kDistinctLayout;
 
   // Stacks of each distinct image, indexed by stack index (0 = original).
   std::array<std::vector<ImageF>, 3> stacks;

@@ -76,6 +76,7 @@ struct PlaneSource {
 using PlaneLayout = std::array<PlaneSource, 3>;
 inline constexpr PlaneLayout kSharedLayout{{{0, false}, {0, false}, {0, false}}};
 inline constexpr PlaneLayout kDistinctLayout{{{0, false}, {1, false}, {2, false}}};
+inline constexpr PlaneLayout kCrossedLayout{{{0, false}, {0, true}, {0, true}}};  // xy = E, yz = zx = E^T
 // The layout of three exemplar images: a plane equal to plane 0's image, pixel for pixel, or to
 // its transpose, shares plane 0's lines; any other plane has its own. Planes 1 and 2 equal to
 // each other but unrelated to plane 0 keep their own lines (rare: no layout makes them).

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <string>
 
+#include "analysis/candidate_triples.h"
 #include "analysis/orientation.h"
 
 namespace solidtex {
@@ -52,15 +53,9 @@ Result<std::shared_ptr<const ImageF>> matching_image(const ImageF& rgb, const st
 namespace {
 
 bool is_crossed(const std::array<std::shared_ptr<const ImageF>, 3>& planes) {
-  if (planes[0] == planes[1]) return false;
-  const ImageF t = transposed(*planes[0]);
-  // A symmetric exemplar (E = E transposed) under a grain layout is not crossed: it keeps slabs.
-  if (t.width == planes[0]->width && t.pixels == planes[0]->pixels) return false;
-  for (int k = 1; k < 3; ++k)
-    if (planes[k]->width != t.width || planes[k]->height != t.height || planes[k]->channels != t.channels ||
-        planes[k]->pixels != t.pixels)
-      return false;
-  return true;
+  // A symmetric exemplar (E = E transposed) under a grain layout is not crossed (its planes
+  // all equal E): it keeps slabs.
+  return plane_layout({planes[0].get(), planes[1].get(), planes[2].get()}) == kCrossedLayout;
 }
 
 }  // namespace
