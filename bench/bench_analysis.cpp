@@ -66,6 +66,8 @@ int main(int argc, char** argv) {
   j["balance_seconds"] = balance_seconds;
   j["total_seconds"] = r->seconds + balance_seconds;
   j["peak_rss_mb"] = double(ru.ru_maxrss) / 1024.0;
+  // What the service admits analyses by (--max-request-mb): it should not be far below the peak.
+  j["estimated_mb"] = double(estimate_analysis_bytes(*set, params)) / double(1 << 20);
   j["table_bytes"] = encode_table(**balanced).size();
   nlohmann::json lv = nlohmann::json::array();
   for (const auto& l : r->levels) lv.push_back({{"level", l.level}, {"ratio_to_random", l.mean_crossbar_error / l.random_crossbar_error}});

@@ -77,7 +77,7 @@ nlohmann::json measure(const Table& table, VoxelCache& cache, int n, const Plane
                             {"spacing", h},
                             {"voxels", m * m},
                             {"coherent", coherent},
-                            {"table_coherent_fraction", table.level(PyramidLevel{l}).candidates.coherent_fraction}};
+                            {"table_coherent_fraction", table.level(PyramidLevel{l}).candidates->coherent_fraction}};
     if (l == levels - 1) {
       const ImageF& xy = ex.plane(Plane::kXY);
       double mean[3] = {0, 0, 0}, var = 0;

@@ -51,7 +51,7 @@ class ProgressSink {
 std::vector<LevelReport> level_reports(const Table& table) {
   std::vector<LevelReport> out;
   for (int l = 0; l < table.levels(); ++l) {
-    const auto& c = table.level(PyramidLevel{l}).candidates;
+    const LevelCandidates& c = *table.level(PyramidLevel{l}).candidates;
     out.push_back({l, table.spacing(PyramidLevel{l}), c.mean_crossbar_error, c.random_crossbar_error, c.coherent_fraction});
   }
   return out;
@@ -127,9 +127,13 @@ int64_t estimate_analysis_bytes(const ExemplarSet& exemplars, const AnalysisPara
   const int64_t per_pixel_level = 16 * params.neighborhood * c + 8 * params.pca_dims + 48 * params.candidates + 128;
   // Plus, for the level being searched only, the k-NN results of two searches per plane.
   const int64_t per_pixel_search = 16 * params.search_k;
+  // Plus usage calibration (usage_balance.h), which runs on the finished table: one more copy
+  // per level of the matching image, appearance vectors and two penalty images (the candidate
+  // lists are shared), next to a small block synthesis (tens of MB, capped by its cache).
+  const int64_t per_pixel_level_calibration = 4 * (c + params.pca_dims + 2);
   int64_t pixels = 0;
   for (int k = 0; k < int(planes); ++k) pixels += exemplars.plane(plane_from_index(k)).pixel_count();
-  return pixels * (params.levels * per_pixel_level + per_pixel_search);
+  return pixels * (params.levels * (per_pixel_level + per_pixel_level_calibration) + per_pixel_search);
 }
 
 }  // namespace solidtex

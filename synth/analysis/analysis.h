@@ -35,8 +35,10 @@ std::vector<LevelReport> level_reports(const Table& table);
 
 // Peak working memory of analyze(exemplars, params), bytes, before any work: per pixel and
 // level of every searched plane, the crossbar lines and neighborhoods in FLANN's index, the
-// projected appearance vectors and the candidate lists (calibrated on 128^2 and 256^2 noise
-// exemplars at the defaults: about 1.3 KB per pixel and level, within 10% of measured RSS).
+// projected appearance vectors and the candidate lists, and usage calibration's copy of the
+// appearance (calibrated on 128^2 and 256^2 noise exemplars at the defaults: about 1.3 KB per
+// pixel and level, within 10% of measured RSS; gravel 512^2: 1.58 GB estimated, 1.61 GB peak
+// RSS of `solidtex analyze`, bench_analysis reports both).
 int64_t estimate_analysis_bytes(const ExemplarSet& exemplars, const AnalysisParams& params);
 
 }  // namespace solidtex

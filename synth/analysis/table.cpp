@@ -62,7 +62,7 @@ Result<std::shared_ptr<const Table>> Table::assemble(AnalysisParams params, Exem
           pc.triples.size() != size_t(img.pixel_count()) * pc.per_pixel)
         return Status(StatusCode::kCorrupt, "candidate table does not match its exemplar");
     }
-    table->levels_[l].candidates = std::move(candidates[l]);
+    table->levels_[l].candidates = std::make_shared<const LevelCandidates>(std::move(candidates[l]));
   }
   return std::shared_ptr<const Table>(std::move(table));
 }

@@ -39,7 +39,8 @@ struct PlaneAppearance {
 
 struct TableLevel {
   std::array<std::shared_ptr<const PlaneAppearance>, 3> planes;  // same pointer when shared
-  LevelCandidates candidates;
+  // Shared, immutable: tables differing only in usage penalties (Table::with_usage) share it.
+  std::shared_ptr<const LevelCandidates> candidates;
 };
 
 // Usage penalties of a whole table: [level][distinct image][pixel] (Table::distinct_images()).

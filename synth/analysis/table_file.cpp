@@ -72,12 +72,12 @@ std::vector<uint8_t> encode_table(const Table& table) {
   for (int k = 0; k < distinct; ++k) write_image(w, table.exemplars().plane(plane_from_index(k)));
   for (int l = 0; l < table.levels(); ++l) {
     const TableLevel& level = table.level(PyramidLevel{l});
-    w.f64(level.candidates.mean_crossbar_error);
-    w.f64(level.candidates.random_crossbar_error);
-    w.f64(level.candidates.coherent_fraction);
+    w.f64(level.candidates->mean_crossbar_error);
+    w.f64(level.candidates->random_crossbar_error);
+    w.f64(level.candidates->coherent_fraction);
     for (int k = 0; k < distinct; ++k) write_pca(w, level.planes[k]->pca);
     for (int k = 0; k < distinct; ++k) {
-      const PlaneCandidates& pc = level.candidates.planes[k];
+      const PlaneCandidates& pc = level.candidates->planes[k];
       w.i32(pc.per_pixel);
       w.bytes(pc.counts);
       for (size_t i = 0; i < pc.counts.size(); ++i)

@@ -42,7 +42,7 @@ TEST(TableFile, RoundTripIsExact) {
       for (int k = 0; k < 3; ++k) {
         const auto& a = t->level(PyramidLevel{l});
         const auto& b = (*back)->level(PyramidLevel{l});
-        EXPECT_EQ(a.candidates.planes[k], b.candidates.planes[k]);
+        EXPECT_EQ(a.candidates->planes[k], b.candidates->planes[k]);
         EXPECT_EQ(a.planes[k]->projected, b.planes[k]->projected);  // derived data reproduced
         EXPECT_EQ(a.planes[k]->stack, b.planes[k]->stack);
       }

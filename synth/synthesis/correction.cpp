@@ -292,7 +292,7 @@ CoordinateTriple best_candidate(const CorrectionContext& ctx, const CoordinateTr
   std::array<Source, 27> list;
   int count = 0;
   for (int k = 0; k < 3; ++k) {
-    const PlaneCandidates& pc = level.candidates.planes[size_t(k)];
+    const PlaneCandidates& pc = level.candidates->planes[size_t(k)];
     const int first = count;
     for (const ExemplarPixel& raw : sources[size_t(k)]) {
       const ExemplarPixel src{ImageF::wrap(raw.x, pc.width), ImageF::wrap(raw.y, pc.height)};
@@ -320,7 +320,7 @@ CoordinateTriple best_candidate(const CorrectionContext& ctx, const CoordinateTr
     const int j1 = k == 0 ? 1 : 0, j2 = k == 2 ? 1 : 2;  // the other planes, ascending
     const PlaneAppearance& a1 = *level.planes[size_t(j1)];
     const PlaneAppearance& a2 = *level.planes[size_t(j2)];
-    const auto cands = level.candidates.planes[size_t(k)].at(src.pixel);
+    const auto cands = level.candidates->planes[size_t(k)].at(src.pixel);
     const size_t take = std::min(cands.size(), size_t(ctx.candidates_per_source));
     for (size_t c = 0; c < take; ++c) {
       term[size_t(j1)].prefetch(pixel_index(a1, cands[c].at[size_t(j1)]));

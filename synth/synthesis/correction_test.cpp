@@ -59,7 +59,7 @@ CoordinateTriple reference(const CorrectionContext& ctx, const CoordinateTriple&
   };
   consider(current);
   for (int k = 0; k < 3; ++k) {
-    const PlaneCandidates& pc = level.candidates.planes[size_t(k)];
+    const PlaneCandidates& pc = level.candidates->planes[size_t(k)];
     for (const ExemplarPixel& raw : sources[size_t(k)]) {
       const auto list = pc.at({ImageF::wrap(raw.x, pc.width), ImageF::wrap(raw.y, pc.height)});
       for (size_t c = 0; c < std::min(list.size(), size_t(ctx.candidates_per_source)); ++c) consider(list[c]);

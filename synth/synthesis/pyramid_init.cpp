@@ -14,7 +14,7 @@ std::array<const ImageF*, kNumPlanes> exemplar_planes(const Table& table) {
 // The first (best by crossbar error) candidate triple of an xy pixel; the pixel itself in
 // every plane when it has none.
 CoordinateTriple first_candidate(const Table& table, ExemplarPixel pixel) {
-  const auto list = table.level(PyramidLevel{0}).candidates.planes[0].at(pixel);
+  const auto list = table.level(PyramidLevel{0}).candidates->planes[0].at(pixel);
   if (!list.empty()) return list[0];
   CoordinateTriple t;
   t.at = {pixel, pixel, pixel};
