@@ -124,16 +124,18 @@ Result<AnalysisResult> analyze(const ExemplarSet& exemplars, const AnalysisParam
 int64_t estimate_analysis_bytes(const ExemplarSet& exemplars, const AnalysisParams& params) {
   const int64_t planes = exemplars.shared() ? 1 : 3;
   const int64_t c = exemplars.channels();
-  const int64_t per_pixel_level = 16 * params.neighborhood * c + 8 * params.pca_dims + 48 * params.candidates + 128;
-  // Plus, for the level being searched only, the k-NN results of two searches per plane.
-  const int64_t per_pixel_search = 16 * params.search_k;
-  // Plus usage calibration (usage_balance.h), which runs on the finished table: one more copy
-  // per level of the matching image, appearance vectors and two penalty images (the candidate
-  // lists are shared), next to a small block synthesis (tens of MB, capped by its cache).
-  const int64_t per_pixel_level_calibration = 4 * (c + params.pca_dims + 2);
+  const int64_t n = params.neighborhood, nt = params.candidates;
+  // Kept per pixel and level: matching image, appearance vectors, typicality penalties, packed
+  // candidate lists with their counts; and usage calibration's copy of the first three plus
+  // usage penalties (usage_balance.h: it runs on the finished table, candidate lists shared).
+  const int64_t per_pixel_level = 4 * c + 4 * params.pca_dims + 4 + (int64_t(sizeof(PackedTriple)) * nt + 1) +
+                                  4 * (c + params.pca_dims + 2);
+  // Transient, for the level being searched and the next one being prepared: the 2*N_T best
+  // pairs (28 B each), both levels' first- and second-axis crossbar lines, the k-NN results.
+  const int64_t per_pixel_search = 28 * 2 * nt + 2 * 2 * 4 * n * c + 16 * params.search_k;
   int64_t pixels = 0;
   for (int k = 0; k < int(planes); ++k) pixels += exemplars.plane(plane_from_index(k)).pixel_count();
-  return pixels * (params.levels * (per_pixel_level + per_pixel_level_calibration) + per_pixel_search);
+  return pixels * (params.levels * per_pixel_level + per_pixel_search);
 }
 
 }  // namespace solidtex

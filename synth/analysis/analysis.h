@@ -33,12 +33,11 @@ Result<AnalysisResult> analyze(const ExemplarSet& exemplars, const AnalysisParam
 
 std::vector<LevelReport> level_reports(const Table& table);
 
-// Peak working memory of analyze(exemplars, params), bytes, before any work: per pixel and
-// level of every searched plane, the crossbar lines and neighborhoods in FLANN's index, the
-// projected appearance vectors and the candidate lists, and usage calibration's copy of the
-// appearance (calibrated on 128^2 and 256^2 noise exemplars at the defaults: about 1.3 KB per
-// pixel and level, within 10% of measured RSS; gravel 512^2: 1.58 GB estimated, 1.61 GB peak
-// RSS of `solidtex analyze`, bench_analysis reports both).
+// Peak working memory of analyze(exemplars, params) plus usage calibration, bytes, before any
+// work, linear in the searched planes' pixels (the service checks it per uploaded image): per
+// pixel and level the table's own arrays, plus the search's transients of two levels. Measured
+// (bench_analysis, peak RSS less the ~130 MB of a process that analysed a 32^2 exemplar):
+// gravel 512^2 626 MB for 713 MB estimated, pebbles 256^2 181 MB for 178 MB.
 int64_t estimate_analysis_bytes(const ExemplarSet& exemplars, const AnalysisParams& params);
 
 }  // namespace solidtex

@@ -84,7 +84,7 @@ void measure_level_candidates(const PlaneStacks& stacks, int n, int spacing, uin
           for (const CoordinateTriple& t : pc.at({x, y})) row_sum[y] += crossbar_error(stacks, t, n, spacing);
     });
     for (double r : row_sum) sum += r;
-    for (uint8_t c : pc.counts) count += c;
+    for (uint8_t c : *pc.counts) count += c;
   }
   level.mean_crossbar_error = count ? sum / double(count) : 0;
   // Random baseline: 4096 uniformly random triples from a hash of (index, spacing, seed).
@@ -199,6 +199,10 @@ Result<LevelCandidates> compute_level_candidates(const CrossbarSearch& search, c
   const int keep = 2 * nt;
   const int dims = search.lines[0].dims;
   const int planes_to_search = shared ? 1 : 3;
+  for (int k = 0; k < 3; ++k)
+    if (stacks[size_t(k)]->width > PackedTriple::kMaxSide || stacks[size_t(k)]->height > PackedTriple::kMaxSide)
+      return Status(StatusCode::kInvalidArgument,
+                    "exemplar sides above " + std::to_string(PackedTriple::kMaxSide) + " pixels cannot be analysed", "exemplar");
 
   // The searches each plane needs: its second-axis lines among plane k+1's first-axis lines,
   // its first-axis lines among plane k+2's second-axis lines. Keyed by (query base, kind,
@@ -333,12 +337,8 @@ Result<LevelCandidates> compute_level_candidates(const CrossbarSearch& search, c
   std::atomic<int64_t> coherent_kept{0}, kept{0};
   for (int k = 0; k < planes_to_search; ++k) {
     const ImageF& img = *stacks[k];
-    PlaneCandidates& pc = level.planes[k];
-    pc.width = img.width;
-    pc.height = img.height;
-    pc.per_pixel = nt;
-    pc.triples.assign(size_t(img.pixel_count()) * nt, CoordinateTriple{});
-    pc.counts.assign(size_t(img.pixel_count()), 0);
+    std::vector<PackedTriple> triples(size_t(img.pixel_count()) * nt);
+    std::vector<uint8_t> counts(size_t(img.pixel_count()), 0);
     const int fa = kPlaneFirstAxis[size_t(k)], sa = kPlaneSecondAxis[size_t(k)];
     tbb::parallel_for(tbb::blocked_range<int>(0, img.height), [&](const tbb::blocked_range<int>& rows) {
       std::vector<Scored> chosen;
@@ -378,19 +378,15 @@ Result<LevelCandidates> compute_level_candidates(const CrossbarSearch& search, c
           std::sort(chosen.begin(), chosen.end(), [](const Scored& u, const Scored& v) {
             return u.error < v.error || (u.error == v.error && u.t < v.t);
           });
-          for (size_t i = 0; i < chosen.size(); ++i) pc.triples[p * nt + i] = chosen[i].t;
-          pc.counts[p] = uint8_t(chosen.size());
+          for (size_t i = 0; i < chosen.size(); ++i) triples[p * nt + i] = PackedTriple::pack(chosen[i].t);
+          counts[p] = uint8_t(chosen.size());
         }
     });
+    level.planes[k] = PlaneCandidates::make(img.width, img.height, nt, std::move(triples), std::move(counts));
   }
   level.coherent_fraction = kept ? double(coherent_kept) / double(kept) : 0.0;
-  if (shared) {
-    for (int k = 1; k < 3; ++k) {
-      PlaneCandidates& pc = level.planes[k];
-      pc = level.planes[0];
-      for (auto& t : pc.triples) t = rotate_planes(t, k);
-    }
-  }
+  if (shared)
+    for (int k = 1; k < 3; ++k) level.planes[k] = level.planes[0].rotated(k);
   return level;
 }
 

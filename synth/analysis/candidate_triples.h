@@ -23,6 +23,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <span>
 #include <vector>
@@ -42,19 +43,113 @@ struct CandidateParams {
   KnnParams knn;
 };
 
-// Triples of one plane at one level; slot (y*width + x)*per_pixel + i.
+// A stored triple: its six coordinates as 16-bit exemplar pixels (stored coordinates lie in
+// their exemplar, at most 65535 pixels per side), half a CoordinateTriple, so that a pixel's
+// 12 candidates span 2.25 cache lines instead of 4.5. Plane k's pair is c[2k], c[2k+1].
+struct PackedTriple {
+  std::array<uint16_t, 6> c{};
+  static constexpr int kMaxSide = 65535;
+  // Requires every coordinate in [0, kMaxSide] (compute_level_candidates checks the images).
+  static PackedTriple pack(const CoordinateTriple& t) {
+    PackedTriple p;
+    for (int k = 0; k < 3; ++k) {
+      p.c[size_t(2 * k)] = uint16_t(t.at[size_t(k)].x);
+      p.c[size_t(2 * k + 1)] = uint16_t(t.at[size_t(k)].y);
+    }
+    return p;
+  }
+  // Stored plane k's pixel (before any rotation).
+  ExemplarPixel stored(int k) const { return {int32_t(c[size_t(2 * k)]), int32_t(c[size_t(2 * k + 1)])}; }
+  // The triple with its planes rotated by r (rotate_planes): out[j] = stored[j - r].
+  CoordinateTriple unpack(int r) const {
+    CoordinateTriple t;
+    for (int j = 0; j < 3; ++j) {
+      const int k = (j - r + 3) % 3;
+      t.at[size_t(j)] = {int32_t(c[size_t(2 * k)]), int32_t(c[size_t(2 * k + 1)])};
+    }
+    return t;
+  }
+  friend bool operator==(const PackedTriple&, const PackedTriple&) = default;
+};
+
+// One pixel's candidates, read as CoordinateTriples (by value) in their plane order.
+class CandidateList {
+ public:
+  class iterator {
+   public:
+    using value_type = CoordinateTriple;
+    using difference_type = std::ptrdiff_t;
+    iterator() = default;
+    iterator(const PackedTriple* p, int r) : p_(p), r_(r) {}
+    CoordinateTriple operator*() const { return p_->unpack(r_); }
+    iterator& operator++() { ++p_; return *this; }
+    iterator operator++(int) { iterator old = *this; ++p_; return old; }
+    friend bool operator==(const iterator& a, const iterator& b) { return a.p_ == b.p_; }
+   private:
+    const PackedTriple* p_ = nullptr;
+    int r_ = 0;
+  };
+  CandidateList(std::span<const PackedTriple> packed, int rotation) : packed_(packed), rotation_(rotation) {}
+  size_t size() const { return packed_.size(); }
+  bool empty() const { return packed_.empty(); }
+  CoordinateTriple operator[](size_t i) const { return packed_[i].unpack(rotation_); }
+  iterator begin() const { return {packed_.data(), rotation_}; }
+  iterator end() const { return {packed_.data() + packed_.size(), rotation_}; }
+  // The stored triples and the rotation they are read with: plane j of triple i is
+  // packed()[i].stored(stored_plane(j)), for hot loops that read single planes.
+  std::span<const PackedTriple> packed() const { return packed_; }
+  int stored_plane(int j) const { return (j - rotation_ + 3) % 3; }
+  int rotation() const { return rotation_; }
+
+ private:
+  std::span<const PackedTriple> packed_;
+  int rotation_ = 0;
+};
+
+// Triples of one plane at one level; slot (y*width + x)*per_pixel + i. Immutable once made
+// and cheap to copy: the lists are shared, so a shared exemplar's planes yz and zx are plane
+// xy's lists read with their planes rotated (rotation 1 and 2), a third of the memory.
 struct PlaneCandidates {
   int width = 0;
   int height = 0;
   int per_pixel = 0;
-  std::vector<CoordinateTriple> triples;
-  std::vector<uint8_t> counts;  // valid triples per pixel, <= per_pixel
+  int rotation = 0;  // stored triples are read through rotate_planes(t, rotation)
+  std::shared_ptr<const std::vector<PackedTriple>> triples;  // width*height*per_pixel slots
+  std::shared_ptr<const std::vector<uint8_t>> counts;        // valid triples per pixel, <= per_pixel
 
-  std::span<const CoordinateTriple> at(ExemplarPixel p) const {
-    const size_t i = size_t(ImageF::wrap(p.y, height)) * width + ImageF::wrap(p.x, width);
-    return {triples.data() + i * per_pixel, counts[i]};
+  static PlaneCandidates make(int width, int height, int per_pixel, std::vector<PackedTriple> triples,
+                              std::vector<uint8_t> counts) {
+    PlaneCandidates pc;
+    pc.width = width;
+    pc.height = height;
+    pc.per_pixel = per_pixel;
+    pc.triples = std::make_shared<const std::vector<PackedTriple>>(std::move(triples));
+    pc.counts = std::make_shared<const std::vector<uint8_t>>(std::move(counts));
+    return pc;
   }
-  friend bool operator==(const PlaneCandidates&, const PlaneCandidates&) = default;
+  // The same lists read with their planes rotated by k more (sharing the storage).
+  PlaneCandidates rotated(int k) const {
+    PlaneCandidates pc = *this;
+    pc.rotation = (rotation + k) % 3;
+    return pc;
+  }
+  CandidateList at(ExemplarPixel p) const {
+    const size_t i = size_t(ImageF::wrap(p.y, height)) * width + ImageF::wrap(p.x, width);
+    return {std::span<const PackedTriple>(triples->data() + i * per_pixel, (*counts)[i]), rotation};
+  }
+  // Equal lists as read (the triples each pixel offers), however they are stored.
+  friend bool operator==(const PlaneCandidates& a, const PlaneCandidates& b) {
+    if (a.width != b.width || a.height != b.height || a.per_pixel != b.per_pixel) return false;
+    if (!a.counts || !b.counts) return !a.counts && !b.counts;
+    if (*a.counts != *b.counts) return false;
+    for (int y = 0; y < a.height; ++y)
+      for (int x = 0; x < a.width; ++x) {
+        const CandidateList la = a.at({x, y}), lb = b.at({x, y});
+        for (size_t i = 0; i < la.size(); ++i)
+          if (la[i] != lb[i]) return false;
+      }
+    return true;
+  }
 };
 
 struct LevelCandidates {

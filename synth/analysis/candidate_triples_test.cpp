@@ -122,7 +122,28 @@ TEST(CandidateTriples, SharedExemplarRotationEqualsSearchingEveryPlane) {
   ImageF a = img, b = img, c = img;  // distinct objects with equal pixels: no sharing shortcut
   auto shared = compute_level_candidates({&img, &img, &img}, true, 2, small_params(), 3, nullptr).value();
   auto full = compute_level_candidates({&a, &b, &c}, false, 2, small_params(), 3, nullptr).value();
-  for (int k = 0; k < 3; ++k) EXPECT_EQ(shared.planes[k], full.planes[k]) << "plane " << k;
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_EQ(shared.planes[k], full.planes[k]) << "plane " << k;
+    // One stored list read three ways: a shared exemplar's table holds a third of the triples.
+    EXPECT_EQ(shared.planes[k].triples.get(), shared.planes[0].triples.get()) << "plane " << k;
+    EXPECT_EQ(shared.planes[k].rotation, k);
+  }
+}
+
+TEST(CandidateTriples, PackedTriplesKeepEveryCoordinateAndRotateLikeRotatePlanes) {
+  CoordinateTriple t;
+  t.at = {ExemplarPixel{0, 65535}, ExemplarPixel{65535, 1}, ExemplarPixel{300, 40000}};
+  const PackedTriple p = PackedTriple::pack(t);
+  EXPECT_EQ(sizeof(PackedTriple), 12u);
+  for (int r = 0; r < 3; ++r) EXPECT_EQ(p.unpack(r), rotate_planes(t, r)) << "rotation " << r;
+  // A list read with rotation r offers rotate_planes of each stored triple, in stored order.
+  const std::vector<PackedTriple> stored{p, PackedTriple::pack(rotate_planes(t, 1))};
+  const CandidateList list(stored, 2);
+  ASSERT_EQ(list.size(), 2u);
+  EXPECT_EQ(list[0], rotate_planes(t, 2));
+  EXPECT_EQ(list[1], rotate_planes(rotate_planes(t, 1), 2));
+  std::vector<CoordinateTriple> walked(list.begin(), list.end());
+  EXPECT_EQ(walked, (std::vector<CoordinateTriple>{list[0], list[1]}));
 }
 
 TEST(CandidateTriples, ThreeDifferentExemplarsAndMasksWork) {

@@ -57,9 +57,9 @@ Result<std::shared_ptr<const Table>> Table::assemble(AnalysisParams params, Exem
     for (int k = 0; k < 3; ++k) {
       const PlaneCandidates& pc = candidates[l].planes[k];
       const ImageF& img = exemplars.plane(plane_from_index(k));
-      if (pc.width != img.width || pc.height != img.height || pc.per_pixel < 1 ||
-          pc.counts.size() != size_t(img.pixel_count()) ||
-          pc.triples.size() != size_t(img.pixel_count()) * pc.per_pixel)
+      if (pc.width != img.width || pc.height != img.height || pc.per_pixel < 1 || !pc.counts || !pc.triples ||
+          pc.counts->size() != size_t(img.pixel_count()) ||
+          pc.triples->size() != size_t(img.pixel_count()) * pc.per_pixel)
         return Status(StatusCode::kCorrupt, "candidate table does not match its exemplar");
     }
     table->levels_[l].candidates = std::make_shared<const LevelCandidates>(std::move(candidates[l]));

@@ -79,10 +79,10 @@ std::vector<uint8_t> encode_table(const Table& table) {
     for (int k = 0; k < distinct; ++k) {
       const PlaneCandidates& pc = level.candidates->planes[k];
       w.i32(pc.per_pixel);
-      w.bytes(pc.counts);
-      for (size_t i = 0; i < pc.counts.size(); ++i)
-        for (int j = 0; j < pc.counts[i]; ++j) {
-          const CoordinateTriple& t = pc.triples[i * pc.per_pixel + j];
+      w.bytes(*pc.counts);
+      for (size_t i = 0; i < pc.counts->size(); ++i)
+        for (int j = 0; j < (*pc.counts)[i]; ++j) {
+          const CoordinateTriple t = pc.at({int(i % size_t(pc.width)), int(i / size_t(pc.width))})[size_t(j)];
           for (int o = 1; o <= 2; ++o) {
             w.u16(uint16_t(t.at[(k + o) % 3].x));
             w.u16(uint16_t(t.at[(k + o) % 3].y));
@@ -162,19 +162,19 @@ Result<std::shared_ptr<const Table>> decode_table(std::span<const uint8_t> bytes
     for (int k = 0; k < distinct; ++k) SOLIDTEX_RETURN_IF_ERROR(read_pca(r, pcas[l][k]));
     if (shared) pcas[l][1] = pcas[l][2] = pcas[l][0];
     for (int k = 0; k < distinct; ++k) {
-      PlaneCandidates& pc = lc.planes[k];
       const ImageF& img = *images[k];
-      pc.width = img.width;
-      pc.height = img.height;
-      SOLIDTEX_RETURN_IF_ERROR(r.i32(pc.per_pixel));
-      if (pc.per_pixel != p.candidates) return corrupt("candidates per pixel do not match the parameters");
-      SOLIDTEX_RETURN_IF_ERROR(r.bytes(pc.counts, size_t(img.pixel_count())));
-      pc.triples.assign(size_t(img.pixel_count()) * pc.per_pixel, CoordinateTriple{});
-      for (size_t i = 0; i < pc.counts.size(); ++i) {
-        if (pc.counts[i] > pc.per_pixel) return corrupt("candidate count exceeds its limit");
-        for (int j = 0; j < pc.counts[i]; ++j) {
-          CoordinateTriple& t = pc.triples[i * pc.per_pixel + j];
-          t.at[k] = {int32_t(i % size_t(img.width)), int32_t(i / size_t(img.width))};
+      int per_pixel = 0;
+      SOLIDTEX_RETURN_IF_ERROR(r.i32(per_pixel));
+      if (per_pixel != p.candidates) return corrupt("candidates per pixel do not match the parameters");
+      std::vector<uint8_t> counts;
+      SOLIDTEX_RETURN_IF_ERROR(r.bytes(counts, size_t(img.pixel_count())));
+      std::vector<PackedTriple> triples(size_t(img.pixel_count()) * per_pixel);
+      for (size_t i = 0; i < counts.size(); ++i) {
+        if (counts[i] > per_pixel) return corrupt("candidate count exceeds its limit");
+        for (int j = 0; j < counts[i]; ++j) {
+          PackedTriple& t = triples[i * per_pixel + j];
+          t.c[size_t(2 * k)] = uint16_t(i % size_t(img.width));  // sides <= 65535 (read_image)
+          t.c[size_t(2 * k + 1)] = uint16_t(i / size_t(img.width));
           for (int o = 1; o <= 2; ++o) {
             const int plane = (k + o) % 3;
             uint16_t x = 0, y = 0;
@@ -182,17 +182,15 @@ Result<std::shared_ptr<const Table>> decode_table(std::span<const uint8_t> bytes
             SOLIDTEX_RETURN_IF_ERROR(r.u16(y));
             if (x >= images[plane]->width || y >= images[plane]->height)
               return corrupt("candidate coordinate outside its exemplar");
-            t.at[plane] = {x, y};
+            t.c[size_t(2 * plane)] = x;
+            t.c[size_t(2 * plane + 1)] = y;
           }
         }
       }
+      lc.planes[k] = PlaneCandidates::make(img.width, img.height, per_pixel, std::move(triples), std::move(counts));
     }
-    if (shared) {
-      for (int k = 1; k < 3; ++k) {
-        lc.planes[k] = lc.planes[0];
-        for (auto& t : lc.planes[k].triples) t = rotate_planes(t, k);
-      }
-    }
+    if (shared)
+      for (int k = 1; k < 3; ++k) lc.planes[k] = lc.planes[0].rotated(k);
   }
   UsagePenalties usage;
   if (version >= 3) {

@@ -301,7 +301,7 @@ CoordinateTriple best_candidate(const CorrectionContext& ctx, const CoordinateTr
       if (seen) continue;
       list[size_t(count++)] = {0.f, k, src};
       // The lists and rows lie far apart in tables of megabytes: ask for them all up front.
-      const auto cands = pc.at(src);
+      const auto cands = pc.at(src).packed();
       const char* bytes = reinterpret_cast<const char*>(cands.data());
       for (size_t off = 0; off < cands.size_bytes(); off += 64) __builtin_prefetch(bytes + off);
       term[size_t(k)].prefetch(pixel_index(*level.planes[size_t(k)], src));
@@ -320,20 +320,23 @@ CoordinateTriple best_candidate(const CorrectionContext& ctx, const CoordinateTr
     const int j1 = k == 0 ? 1 : 0, j2 = k == 2 ? 1 : 2;  // the other planes, ascending
     const PlaneAppearance& a1 = *level.planes[size_t(j1)];
     const PlaneAppearance& a2 = *level.planes[size_t(j2)];
-    const auto cands = level.candidates->planes[size_t(k)].at(src.pixel);
+    const CandidateList list = level.candidates->planes[size_t(k)].at(src.pixel);
+    const std::span<const PackedTriple> cands = list.packed();
+    const int sk = list.stored_plane(k), s1 = list.stored_plane(j1), s2 = list.stored_plane(j2);
     const size_t take = std::min(cands.size(), size_t(ctx.candidates_per_source));
     for (size_t c = 0; c < take; ++c) {
-      term[size_t(j1)].prefetch(pixel_index(a1, cands[c].at[size_t(j1)]));
-      term[size_t(j2)].prefetch(pixel_index(a2, cands[c].at[size_t(j2)]));
+      term[size_t(j1)].prefetch(pixel_index(a1, cands[c].stored(s1)));
+      term[size_t(j2)].prefetch(pixel_index(a2, cands[c].stored(s2)));
     }
     for (size_t c = 0; c < take; ++c) {
-      const CoordinateTriple& t = cands[c];
+      const PackedTriple& t = cands[c];
       std::array<float, 3> tk;
-      tk[size_t(k)] = t.at[size_t(k)] == src.pixel ? src.own : term[size_t(k)](pixel_index(*level.planes[size_t(k)], t.at[size_t(k)]));
-      tk[size_t(j1)] = term[size_t(j1)](pixel_index(a1, t.at[size_t(j1)]));
+      const ExemplarPixel own = t.stored(sk);
+      tk[size_t(k)] = own == src.pixel ? src.own : term[size_t(k)](pixel_index(*level.planes[size_t(k)], own));
+      tk[size_t(j1)] = term[size_t(j1)](pixel_index(a1, t.stored(s1)));
       if (tk[size_t(k)] + tk[size_t(j1)] > best) continue;
-      tk[size_t(j2)] = term[size_t(j2)](pixel_index(a2, t.at[size_t(j2)]));
-      offer((tk[0] + tk[1]) + tk[2], t);
+      tk[size_t(j2)] = term[size_t(j2)](pixel_index(a2, t.stored(s2)));
+      offer((tk[0] + tk[1]) + tk[2], t.unpack(list.rotation()));
     }
   }
   return best_t;

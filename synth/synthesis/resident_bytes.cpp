@@ -39,7 +39,8 @@ int64_t table_resident_bytes(const Table& table) {
         bytes += int64_t(sizeof(PlaneAppearance)) + kBlockOverhead + vector_bytes(app->stack.pixels) +
                  pca_bytes(app->pca) + vector_bytes(app->projected) +
                  vector_bytes(app->typicality) + vector_bytes(app->usage);
-    for (const PlaneCandidates& pc : level.candidates->planes) bytes += vector_bytes(pc.triples) + vector_bytes(pc.counts);
+    for (const PlaneCandidates& pc : level.candidates->planes)
+      if (pc.triples && seen.insert(pc.triples.get()).second) bytes += vector_bytes(*pc.triples) + vector_bytes(*pc.counts);
   }
   return bytes;
 }
