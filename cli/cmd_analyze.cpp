@@ -1,6 +1,7 @@
 // solidtex analyze IMAGE [--yz IMAGE --zx IMAGE] [--mask IMAGE [--mask-yz IMAGE --mask-zx IMAGE]]
 //   [--mask-weight W] [--levels 4] [--neighborhood 9] [--candidates 12] [--pca-dims 20]
 //   [--search-k 24] [--knn-checks 192] [--balance-rounds 3] [--balance-box 24] [--balance-strength 0.025]
+//   [--balance-fine-gain 2]
 //   [--seed S] [--threads T] [--grain auto|none|x|y|crossed] -o TABLE.stx [--json]
 #include <nlohmann/json.hpp>
 
@@ -34,7 +35,7 @@ Result<std::optional<ImageF>> optional_image(const Args& args, const std::string
 Status run_analyze(const std::vector<std::string>& argv) {
   Args args({"-o", "--yz", "--zx", "--mask", "--mask-yz", "--mask-zx", "--mask-weight", "--levels",
              "--neighborhood", "--candidates", "--pca-dims", "--search-k", "--knn-checks", "--seed", "--threads", "--grain",
-             "--balance-rounds", "--balance-box", "--balance-strength"},
+             "--balance-rounds", "--balance-box", "--balance-strength", "--balance-fine-gain"},
             {"--json"});
   SOLIDTEX_RETURN_IF_ERROR(args.parse(argv));
   if (args.positionals().size() != 1)
@@ -56,6 +57,8 @@ Status run_analyze(const std::vector<std::string>& argv) {
   SOLIDTEX_ASSIGN_OR_RETURN(balance.box, args.get_int("--balance-box", balance.box, 8, 64));
   SOLIDTEX_ASSIGN_OR_RETURN(double strength, args.get_double("--balance-strength", balance.strength, 0, 1));
   balance.strength = float(strength);
+  SOLIDTEX_ASSIGN_OR_RETURN(double fine_gain, args.get_double("--balance-fine-gain", balance.fine_gain, 0.25, 4));
+  balance.fine_gain = float(fine_gain);
   SOLIDTEX_RETURN_IF_ERROR(balance.validate());
   SOLIDTEX_RETURN_IF_ERROR(params.validate());
   SOLIDTEX_ASSIGN_OR_RETURN(int threads, args.get_int("--threads", 0, 0, 1024));
@@ -109,7 +112,8 @@ Status run_analyze(const std::vector<std::string>& argv) {
                    {"candidates", params.candidates}, {"pca_dims", params.pca_dims},
                    {"search_k", params.search_k},     {"knn_checks", params.knn_checks},
                    {"seed", params.seed},             {"balance_rounds", balance.rounds},
-                   {"balance_box", balance.box},      {"balance_strength", balance.strength}};
+                   {"balance_box", balance.box},      {"balance_strength", balance.strength},
+                   {"balance_fine_gain", balance.fine_gain}};
     std::cout << j.dump(2) << "\n";
   } else {
     std::cout << "wrote " << out << " (" << bytes.size() << " bytes) in " << result.seconds << " s + "

@@ -27,7 +27,7 @@ constexpr const char* kUsage =
     "  analyze IMAGE [--yz IMAGE --zx IMAGE] [--mask IMAGE] [--levels 4] [--neighborhood 9]\n"
     "          [--candidates 12] [--pca-dims 20] [--seed S] [--threads T] [--grain auto|none|x|y|crossed]\n"
     "          [--search-k 24] [--knn-checks 192] [--balance-rounds 3] [--balance-box 24]\n"
-    "          [--balance-strength 0.025]\n"
+    "          [--balance-strength 0.025] [--balance-fine-gain 2]\n"
     "          -o TABLE.stx [--json]\n"
     "  slice TABLE.stx (--axis x|y|z --at K [--origin U,V] | --plane OX,OY,OZ,UX,UY,UZ,VX,VY,VZ)\n"
     "          --size W,H [--scheme plain|subpass|grid|dual-grid] [--field identity|quat:W,X,Y,Z|FILE]\n"

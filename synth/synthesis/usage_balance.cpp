@@ -128,6 +128,7 @@ Status UsageBalanceParams::validate() const {
   if (!(strength >= 0.f && strength <= 1.f)) return Status(StatusCode::kInvalidArgument, "must be in [0, 1]", "strength");
   if (!(sigma >= 0.5f && sigma <= 32.f)) return Status(StatusCode::kInvalidArgument, "must be in [0.5, 32]", "sigma");
   if (box < 8 || box > 64) return Status(StatusCode::kInvalidArgument, "must be in [8, 64]", "box");
+  if (!(fine_gain >= 0.25f && fine_gain <= 4.f)) return Status(StatusCode::kInvalidArgument, "must be in [0.25, 4]", "fine_gain");
   return Status::ok();
 }
 
@@ -174,6 +175,12 @@ Result<std::shared_ptr<const Table>> balance_usage(std::shared_ptr<const Table> 
     }
   }
   if (interrupter.was_interrupted(100)) return Status(StatusCode::kCancelled, "usage balancing was cancelled");
+  const ExemplarSet& e = table->exemplars();
+  if (e.shared() || e.crossed())
+    for (int l = 0; l < levels; ++l)
+      if (table->spacing(PyramidLevel{l}) <= 2)
+        for (auto& image : usage[size_t(l)])
+          for (float& u : image) u *= params.fine_gain;
   return table->with_usage(std::move(usage));
 }
 

@@ -82,6 +82,29 @@ TEST(UsageBalance, BalanceZeroIsTheUnbalancedSynthesis) {
   EXPECT_NE(finest_block(balanced, 1.f, at), finest_block(table, 1.f, at));
 }
 
+TEST(UsageBalance, FineGainScalesOnlyTheFinerLevelsOfIsotropicTables) {
+  auto table = small_table(ProceduralKind::kNoise);
+  ASSERT_TRUE(table->exemplars().shared());
+  UsageBalanceParams one = small_balance(), two = small_balance();
+  one.fine_gain = 1.f;
+  two.fine_gain = 2.f;
+  auto a = balance_usage(table, one).value(), b = balance_usage(table, two).value();
+  const UsagePenalties pa = a->usage(), pb = b->usage();
+  bool any_positive = false;
+  for (int l = 0; l < table->levels(); ++l) {
+    const float gain = table->spacing(PyramidLevel{l}) <= 2 ? 2.f : 1.f;
+    for (size_t k = 0; k < pa[size_t(l)].size(); ++k)
+      for (size_t i = 0; i < pa[size_t(l)][k].size(); ++i) {
+        ASSERT_EQ(pb[size_t(l)][k][i], gain * pa[size_t(l)][k][i]) << "level " << l;
+        any_positive = any_positive || (gain > 1.f && pa[size_t(l)][k][i] > 0.f);
+      }
+  }
+  EXPECT_TRUE(any_positive);  // the finer levels have penalties to scale
+  UsageBalanceParams bad = small_balance();
+  bad.fine_gain = 5.f;
+  EXPECT_EQ(bad.validate().field(), "fine_gain");
+}
+
 TEST(UsageBalance, ParametersAreValidatedAndCancellationIsClean) {
   UsageBalanceParams b;
   b.box = 4;
