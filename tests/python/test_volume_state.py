@@ -16,8 +16,9 @@ import requests
 from support import CUBE_OFF, HTTP_TIMEOUT, RAW_F32, ServerFactory, metric_lines, post_bytes, upload_ready
 
 MB = 1 << 20
-# Each 64x64 exemplar's table (3 levels) is about 4 MB decoded: the budget holds two volumes.
-BUDGET_MB = 10
+# Each 64x64 exemplar's volume state (a 3-level table with packed candidate lists, shared by
+# the three planes; its synthesizer and field) is about 1.4 MB: the budget holds two volumes.
+BUDGET_MB = 3
 
 
 def metrics(s) -> Dict[str, float]:
@@ -67,7 +68,7 @@ def wait_for(predicate, seconds: float, what: str) -> None:
 
 @pytest.fixture(scope="module")
 def budget(binary, exemplars, tmp_path_factory):
-    """A server with --volume-state-mb 10 (no idle eviction) and one volume per exemplar kind."""
+    """A server with --volume-state-mb 3 (no idle eviction) and one volume per exemplar kind."""
     factory = ServerFactory(tmp_path_factory.mktemp("volume-state"))
     try:
         s = factory.start("--threads", "2", "--volume-state-mb", BUDGET_MB, "--idle-evict-s", "0")
