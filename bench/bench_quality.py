@@ -6,6 +6,7 @@ Embark's 2D texture-synthesis on the same exemplar and size.
                   [--typicality T]   (synthesis' typicality weight; default: the CLI's default)
                   [--seeds 1,2,3]    (volume seeds; a single cut's swd varies by seed, so an
                                       exemplar's score is its worst-of-four swd averaged over them)
+                  [--resample nearest|cubic] (the oblique cut's sampling; default nearest)
                   [--analyze-args "--grain crossed"] (extra analyze flags, for the exemplars
                                       not analysed with --grain x)
                   [--embark-cache F] (Embark's scores per exemplar and size, kept in F and reused:
@@ -91,6 +92,8 @@ def main() -> int:
     ap.add_argument("--slice-args", default="", help="extra `solidtex slice` flags, e.g. \"--passes 1\"")
     ap.add_argument("--analyze-args", default="",
                     help="extra `solidtex analyze` flags for the exemplars analysed with defaults, e.g. \"--grain crossed\"")
+    ap.add_argument("--resample", default="nearest", choices=["nearest", "cubic"],
+                    help="how the oblique cut samples the voxels (solidtex slice --resample)")
     ap.add_argument("--seeds", default="1", help="comma-separated volume seeds")
     ap.add_argument("--embark-cache", type=Path, default=None)
     args = ap.parse_args()
@@ -124,7 +127,7 @@ def main() -> int:
                 table.parent.mkdir(parents=True, exist_ok=True)
                 run([solidtex, "analyze", ex, *grain, "-o", table])
             cuts = {"z": ["--axis", "z", "--at", "0"], "y": ["--axis", "y", "--at", "0"],
-                    "x": ["--axis", "x", "--at", "0"], "oblique": ["--plane", OBLIQUE]}
+                    "x": ["--axis", "x", "--at", "0"], "oblique": ["--plane", OBLIQUE, "--resample", args.resample]}
             entry = {"exemplar": name, "grain": "x" if name in GRAIN_X else "", "analyze_args": [] if name in GRAIN_X else grain, "size": n, "seeds": {}}
             images = [ex]
             for seed in seeds:
@@ -173,7 +176,7 @@ def main() -> int:
     if ratios:
         summary.update({"median_worst_swd_over_embark": float(np.median(ratios)),
                         "max_worst_swd_over_embark": float(np.max(ratios))})
-    print(json.dumps({"size": n, "typicality": args.typicality, "slice_args": args.slice_args, "analyze_args": args.analyze_args, "seeds": seeds,
+    print(json.dumps({"size": n, "typicality": args.typicality, "slice_args": args.slice_args, "resample": args.resample, "analyze_args": args.analyze_args, "seeds": seeds,
                       "montages": str(out_dir), "exemplars": results, "summary": summary}, indent=1))
     return 0
 

@@ -1,4 +1,4 @@
-// solidtex slice TABLE.stx (--axis x|y|z --at K --origin U,V | --plane OX,OY,OZ,UX,UY,UZ,VX,VY,VZ)
+// solidtex slice TABLE.stx (--axis x|y|z --at K --origin U,V | --plane OX,OY,OZ,UX,UY,UZ,VX,VY,VZ [--resample nearest|cubic])
 //   --size W,H [--scheme plain|subpass|grid|dual-grid] [--field identity|quat:W,X,Y,Z|axis:..|FILE]
 //   [--seed S] [--threads T] [--passes P] [--coarse-passes P] [--cell M] -o OUT.png [--stats STATS.json]
 #include <nlohmann/json.hpp>
@@ -45,8 +45,16 @@ Result<TargetSet> parse_cut(const Args& args) {
     if (args.has("--axis") || args.has("--at") || args.has("--origin"))
       return Status(StatusCode::kInvalidArgument, "give either --plane or --axis/--at/--origin", "--plane");
     SOLIDTEX_ASSIGN_OR_RETURN(auto p, args.get_list("--plane", 9));
-    return TargetSet::plane_cut({p[0], p[1], p[2]}, {p[3], p[4], p[5]}, {p[6], p[7], p[8]}, w, h);
+    PlaneSampling sampling = PlaneSampling::kNearest;
+    if (args.has("--resample")) {
+      SOLIDTEX_ASSIGN_OR_RETURN(std::string name, args.required("--resample"));
+      auto parsed = parse_plane_sampling(name);
+      if (!parsed) return Status(StatusCode::kInvalidArgument, "must be nearest or cubic", "--resample");
+      sampling = *parsed;
+    }
+    return TargetSet::plane_cut({p[0], p[1], p[2]}, {p[3], p[4], p[5]}, {p[6], p[7], p[8]}, w, h, sampling);
   }
+  if (args.has("--resample")) return Status(StatusCode::kInvalidArgument, "applies to --plane cuts only", "--resample");
   SOLIDTEX_ASSIGN_OR_RETURN(std::string axis, args.required("--axis"));
   if (axis.size() != 1) return Status(StatusCode::kInvalidArgument, "must be x, y or z", "--axis");
   SOLIDTEX_ASSIGN_OR_RETURN(int at, args.get_int("--at", 0, -(1 << 28), 1 << 28));
@@ -58,7 +66,7 @@ Result<TargetSet> parse_cut(const Args& args) {
 }
 
 Status run_slice(const std::vector<std::string>& argv) {
-  Args args({"-o", "--axis", "--at", "--origin", "--plane", "--size", "--scheme", "--field", "--seed", "--threads",
+  Args args({"-o", "--axis", "--at", "--origin", "--plane", "--resample", "--size", "--scheme", "--field", "--seed", "--threads",
              "--stats", "--passes", "--coarse-passes", "--cell", "--cache-mb", "--plane-weights", "--matcher", "--region-table", "--regions",
              "--typicality", "--balance", "--init", "--color", "--finest-subpass-size"},
             {"--energy"});

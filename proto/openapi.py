@@ -191,7 +191,8 @@ S = {
      "origin": {**vec3, "description": "Voxels of dataset `scale` (world units, the finest voxels, by default)."},
      "u": {**vec3, "description": "Step per output column, in voxels of dataset `scale`."},
      "v": {**vec3, "description": "Step per output row, in voxels of dataset `scale`."},
-     "size": {"type": "array", "items": integer(1, MAX_CUT_SIDE), "minItems": 2, "maxItems": 2, "description": "W, H."}}},
+     "size": {"type": "array", "items": integer(1, MAX_CUT_SIDE), "minItems": 2, "maxItems": 2, "description": "W, H."},
+     "resample": {"type": "string", "enum": ["nearest", "cubic"], "default": "nearest", "description": "nearest: each pixel is the voxel nearest its position. cubic: the Catmull-Rom (tricubic) combination of the 4x4x4 voxels around it, clamped to their range: no jaggies along tilted planes, softer 1-voxel detail. At integer positions both give that voxel."}}},
  "PointsRequest": {"type": "object", "additionalProperties": False, "required": ["points"], "properties": {
      "points": {"type": "array", "minItems": 1, "items": vec3, "description": "World points; at most --max-voxels of them (else 422)."}}},
  "Mesh": {"type": "object", "required": ["id"], "properties": {
@@ -313,7 +314,7 @@ paths = {
      "description": IMMUTABLE_IMAGE + " " + RANGED,
      "responses": {"200": image_out, **IMAGE_RANGE_OUT, **errs("400", "404", "422", "503", "504")}}},
  "/v1/volumes/{id}/cut": {"parameters": [pid()],
-   "post": {"operationId": "cut", "summary": "Arbitrary planar cut: pixel (i, j) is the voxel of dataset `scale` (the finest voxels by default) nearest origin + i*u + j*v, all in that dataset's voxels.", "parameters": [scale_param, timeout],
+   "post": {"operationId": "cut", "summary": "Arbitrary planar cut: pixel (i, j) is the voxel of dataset `scale` (the finest voxels by default) nearest origin + i*u + j*v, all in that dataset's voxels, or with `resample` cubic their Catmull-Rom resampling around that position.", "parameters": [scale_param, timeout],
      "requestBody": {"required": True, "content": {"application/json": {"schema": ref("Cut")}}},
      "description": IMMUTABLE_IMAGE,
      "responses": {"200": image_out, **errs("400", "404", "413", "415", "422", "503", "504")}}},

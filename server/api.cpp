@@ -500,7 +500,7 @@ HttpResponse Api::cut(const HttpRequest& r) {
     SOLIDTEX_ASSIGN_OR_RETURN(QueryParams q, QueryParams::parse(r.query, {"scale", "timeout"}));
     SOLIDTEX_RETURN_IF_ERROR(require_json_body(r));
     SOLIDTEX_ASSIGN_OR_RETURN(json j, parse_request_json(r.body, "body"));
-    SOLIDTEX_RETURN_IF_ERROR(check_keys(j, {"origin", "u", "v", "size"}, ""));
+    SOLIDTEX_RETURN_IF_ERROR(check_keys(j, {"origin", "u", "v", "size", "resample"}, ""));
     for (const char* k : {"origin", "u", "v", "size"})
       if (!j.contains(k)) return Status(StatusCode::kInvalidArgument, "is required", k);
     SOLIDTEX_ASSIGN_OR_RETURN(WorldPoint origin, json_point(j["origin"], "origin"));
@@ -512,7 +512,12 @@ HttpResponse Api::cut(const HttpRequest& r) {
     SOLIDTEX_ASSIGN_OR_RETURN(int64_t h, json_int(j["size"][1], "size", 1, kMaxCutSide));
     SOLIDTEX_RETURN_IF_ERROR(volumes_.check_target_size(w * h, "size"));
     SOLIDTEX_ASSIGN_OR_RETURN(const int level, level_of_scale(r, q));
-    SOLIDTEX_ASSIGN_OR_RETURN(TargetSet target, TargetSet::plane_cut(origin, u, v, int(w), int(h)));
+    PlaneSampling sampling = PlaneSampling::kNearest;
+    if (j.contains("resample")) {
+      if (!j["resample"].is_string()) return Status(StatusCode::kInvalidArgument, "must be nearest or cubic", "resample");
+      SOLIDTEX_ASSIGN_OR_RETURN(sampling, parse_plane_sampling(j["resample"].get<std::string>()));
+    }
+    SOLIDTEX_ASSIGN_OR_RETURN(TargetSet target, TargetSet::plane_cut(origin, u, v, int(w), int(h), sampling));
     return synthesize_image(r, "cut", target, q.get("timeout"), level);
   }();
   return result ? *result : HttpResponse::error(result.status());

@@ -63,10 +63,7 @@ struct PackedTriple {
   // The triple with its planes rotated by r (rotate_planes): out[j] = stored[j - r].
   CoordinateTriple unpack(int r) const {
     CoordinateTriple t;
-    for (int j = 0; j < 3; ++j) {
-      const int k = (j - r + 3) % 3;
-      t.at[size_t(j)] = {int32_t(c[size_t(2 * k)]), int32_t(c[size_t(2 * k + 1)])};
-    }
+    for (int j = 0; j < 3; ++j) t.at[size_t(j)] = stored((j - r + 3) % 3);
     return t;
   }
   friend bool operator==(const PackedTriple&, const PackedTriple&) = default;

@@ -74,12 +74,10 @@ Result<std::vector<std::array<float, 3>>> RegionVolume::synthesize(const TargetS
     const TargetSet sub = TargetSet::from_voxels(parts[k], int(parts[k].size()), 1);
     SOLIDTEX_ASSIGN_OR_RETURN(colors[k], regions_[k]->synthesize(sub, interrupter, stats ? &(*stats)[k] : nullptr, options));
   }
-  std::vector<std::array<float, 3>> out(target.sample.size());
-  for (size_t s = 0; s < target.sample.size(); ++s) {
-    const auto& [k, idx] = where[target.sample[s]];
-    out[s] = colors[size_t(k)][idx];
-  }
-  return out;
+  if (options.dependencies_only) return std::vector<std::array<float, 3>>{};
+  std::vector<std::array<float, 3>> voxel_rgb(target.voxels.size());
+  for (size_t i = 0; i < target.voxels.size(); ++i) voxel_rgb[i] = colors[size_t(where[i].first)][where[i].second];
+  return target.resolve(voxel_rgb);
 }
 
 }  // namespace solidtex

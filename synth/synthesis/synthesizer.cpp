@@ -452,10 +452,7 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize(const TargetSe
     stats.corrections += ls.corrections;
   }
   std::vector<std::array<float, 3>> out;
-  if (!options.dependencies_only) {
-    out.resize(target.sample.size());
-    for (size_t i = 0; i < target.sample.size(); ++i) out[i] = voxel_rgb[target.sample[i]];
-  }
+  if (!options.dependencies_only) out = target.resolve(voxel_rgb);
   interrupter.end();
   stats.seconds = since(t_start);
   if (stats_out) *stats_out = std::move(stats);

@@ -207,6 +207,54 @@ TEST_F(SynthesizerTest, PlaneCutsAndPointsMatchAxisCuts) {
   EXPECT_EQ(pv[1], axis[size_t(5 * 10 + 9)]);
 }
 
+// A plane cut's pixel is the Catmull-Rom combination of the 4x4x4 voxels around its position,
+// clamped to their range: checked against the voxels themselves, synthesized as boxes.
+TEST_F(SynthesizerTest, PlaneCutsResampleTheVoxelsWithCatmullRom) {
+  auto s = make(table_, "identity", small_params(), 0);
+  const WorldPoint o{2.3, -1.6, 4.45}, u{0.6, 0.8, 0}, v{-0.48, 0.36, 0.8};
+  const int w = 5, h = 4;
+  const auto got = s->synthesize(TargetSet::plane_cut(o, u, v, w, h, PlaneSampling::kCubic).value()).value();
+  ASSERT_EQ(got.size(), size_t(w * h));
+  auto weights = [](double t) {  // Keys' cubic with a = -0.5 at distances 1 + t, t, 1 - t, 2 - t
+    auto k = [](double x) {
+      x = std::abs(x);
+      return x < 1 ? 1.5 * x * x * x - 2.5 * x * x + 1 : x < 2 ? -0.5 * x * x * x + 2.5 * x * x - 4 * x + 2 : 0.0;
+    };
+    return std::array<double, 4>{k(1 + t), k(t), k(1 - t), k(2 - t)};
+  };
+  int differs_from_nearest = 0;
+  for (int j = 0; j < h; ++j)
+    for (int i = 0; i < w; ++i) {
+      const double p[3] = {o.x + i * u.x + j * v.x, o.y + i * u.y + j * v.y, o.z + i * u.z + j * v.z};
+      const Voxel lo{int(std::floor(p[0])) - 1, int(std::floor(p[1])) - 1, int(std::floor(p[2])) - 1};
+      const auto box = s->synthesize(TargetSet::box(lo, 4, 4, 4).value()).value();  // x fastest, then y, z
+      const auto wx = weights(p[0] - std::floor(p[0])), wy = weights(p[1] - std::floor(p[1])),
+                 wz = weights(p[2] - std::floor(p[2]));
+      const auto& pixel = got[size_t(j * w + i)];
+      for (int c = 0; c < 3; ++c) {
+        double sum = 0, mn = 1e30, mx = -1e30;
+        for (int z = 0; z < 4; ++z)
+          for (int y = 0; y < 4; ++y)
+            for (int x = 0; x < 4; ++x) {
+              const double wt = wx[size_t(x)] * wy[size_t(y)] * wz[size_t(z)];
+              const double val = box[size_t((z * 4 + y) * 4 + x)][size_t(c)];
+              sum += wt * val;
+              if (wt != 0) mn = std::min(mn, val), mx = std::max(mx, val);
+            }
+        EXPECT_NEAR(pixel[size_t(c)], std::clamp(sum, mn, mx), 1e-5) << i << "," << j << " channel " << c;
+      }
+      const auto nearest = s->synthesize(TargetSet::points({{p[0], p[1], p[2]}}).value()).value();
+      differs_from_nearest += nearest[0] != pixel;
+    }
+  EXPECT_GT(differs_from_nearest, w * h / 2);  // it resamples, it does not just pick voxels
+  // Along the axes cubic sampling is the axis cut, bit for bit; nearest (the default) picks voxels.
+  EXPECT_EQ(s->synthesize(TargetSet::plane_cut({-3, 7, 4}, {1, 0, 0}, {0, 0, 1}, 10, 6, PlaneSampling::kCubic).value()).value(),
+            cut(*s, 'y', 7, -3, 4, 10, 6));
+  const auto nearest_cut = s->synthesize(TargetSet::plane_cut(o, u, v, w, h).value()).value();
+  EXPECT_EQ(nearest_cut[0], s->synthesize(TargetSet::points({o}).value()).value()[0]);
+  EXPECT_EQ(parse_plane_sampling("bilinear").status().field(), "resample");
+}
+
 TEST_F(SynthesizerTest, DependencySetsAreSoundAndTightForEveryScheme) {
   for (Scheme scheme : {Scheme::kPlain, Scheme::kSubpass, Scheme::kGrid, Scheme::kDualGrid}) {
     for (const char* field : {"identity", "axis:1,2,3,37"}) {

@@ -24,6 +24,33 @@ Status check_point(const WorldPoint& p, const char* field) {
   return Status::ok();
 }
 
+// Catmull-Rom weights of the taps at floor(p) - 1 .. floor(p) + 2 for t = p - floor(p) in [0, 1):
+// (0, 1, 0, 0) exactly at t = 0.
+std::array<float, 4> catmull_rom_weights(float t) {
+  const float t2 = t * t, t3 = t2 * t;
+  return {0.5f * (-t3 + 2.f * t2 - t), 0.5f * (3.f * t3 - 5.f * t2 + 2.f), 0.5f * (-3.f * t3 + 4.f * t2 + t),
+          0.5f * (t3 - t2)};
+}
+
+// The taps floor - 1 .. floor + 2 per axis with a non-zero product weight, x fastest, and
+// their weights: at integer positions (t = 0) the single voxel at floor, weight exactly 1.
+template <class F>
+void for_each_tap(const Voxel& floor, const std::array<float, 3>& t, F&& f) {
+  const std::array<std::array<float, 4>, 3> w{catmull_rom_weights(t[0]), catmull_rom_weights(t[1]),
+                                               catmull_rom_weights(t[2])};
+  const int first[3] = {floor.x - 1, floor.y - 1, floor.z - 1};
+  for (int c = 0; c < 4; ++c) {
+    if (w[2][size_t(c)] == 0.f) continue;
+    for (int b = 0; b < 4; ++b) {
+      if (w[1][size_t(b)] == 0.f) continue;
+      for (int a = 0; a < 4; ++a) {
+        if (w[0][size_t(a)] == 0.f) continue;
+        f(Voxel{first[0] + a, first[1] + b, first[2] + c}, (w[0][size_t(a)] * w[1][size_t(b)]) * w[2][size_t(c)]);
+      }
+    }
+  }
+}
+
 }  // namespace
 
 VoxelBox TargetSet::bounds() const {
@@ -62,20 +89,88 @@ Result<TargetSet> TargetSet::axis_cut(char axis, int at, int u0, int v0, int wid
   return from_voxels(s, width, height);
 }
 
-Result<TargetSet> TargetSet::plane_cut(const WorldPoint& o, const WorldPoint& u, const WorldPoint& v, int width, int height) {
+Result<PlaneSampling> parse_plane_sampling(const std::string& name) {
+  if (name == "nearest") return PlaneSampling::kNearest;
+  if (name == "cubic") return PlaneSampling::kCubic;
+  return Status(StatusCode::kInvalidArgument, "must be nearest or cubic", "resample");
+}
+
+Result<TargetSet> TargetSet::plane_cut(const WorldPoint& o, const WorldPoint& u, const WorldPoint& v, int width, int height,
+                                       PlaneSampling sampling) {
   SOLIDTEX_RETURN_IF_ERROR(check_size(width, height));
   SOLIDTEX_RETURN_IF_ERROR(check_point(o, "origin"));
   SOLIDTEX_RETURN_IF_ERROR(check_point(u, "u"));
   SOLIDTEX_RETURN_IF_ERROR(check_point(v, "v"));
   const WorldPoint far{o.x + u.x * width + v.x * height, o.y + u.y * width + v.y * height, o.z + u.z * width + v.z * height};
   SOLIDTEX_RETURN_IF_ERROR(check_point(far, "size"));
-  std::vector<Voxel> s;
-  s.reserve(size_t(width) * height);
-  for (int j = 0; j < height; ++j)
-    for (int i = 0; i < width; ++i)
-      s.push_back({int(std::lround(o.x + i * u.x + j * v.x)), int(std::lround(o.y + i * u.y + j * v.y)),
-                   int(std::lround(o.z + i * u.z + j * v.z))});
-  return from_voxels(s, width, height);
+  if (sampling == PlaneSampling::kNearest) {
+    std::vector<Voxel> s;
+    s.reserve(size_t(width) * height);
+    for (int j = 0; j < height; ++j)
+      for (int i = 0; i < width; ++i)
+        s.push_back({int(std::lround(o.x + i * u.x + j * v.x)), int(std::lround(o.y + i * u.y + j * v.y)),
+                     int(std::lround(o.z + i * u.z + j * v.z))});
+    return from_voxels(s, width, height);
+  }
+  const size_t n = size_t(width) * height;
+  TargetSet t;
+  t.width = width;
+  t.height = height;
+  t.resample_floor.resize(n);
+  t.resample_t.resize(n);
+  std::vector<Voxel> nearest(n), needed;
+  // Neighbouring samples share most of their 4x4x4 taps: deduplicate as the list grows, so
+  // memory stays near the distinct voxels (a slab ~5 voxels thick), not 64 per sample.
+  size_t distinct = 0;
+  auto dedupe = [&] {
+    std::sort(needed.begin(), needed.end());
+    needed.erase(std::unique(needed.begin(), needed.end()), needed.end());
+    distinct = needed.size();
+  };
+  for (int j = 0; j < height; ++j) {
+    for (int i = 0; i < width; ++i) {
+      const size_t k = size_t(j) * width + i;
+      const double p[3] = {o.x + i * u.x + j * v.x, o.y + i * u.y + j * v.y, o.z + i * u.z + j * v.z};
+      int fl[3];
+      for (int a = 0; a < 3; ++a) {
+        const double f = std::floor(p[a]);
+        fl[a] = int(f);
+        t.resample_t[k][size_t(a)] = float(p[a] - f);
+      }
+      t.resample_floor[k] = {fl[0], fl[1], fl[2]};
+      nearest[k] = {int(std::lround(p[0])), int(std::lround(p[1])), int(std::lround(p[2]))};
+      for_each_tap(t.resample_floor[k], t.resample_t[k], [&](const Voxel& q, float) { needed.push_back(q); });
+    }
+    if (needed.size() > 4 * distinct + (size_t(1) << 20)) dedupe();
+  }
+  dedupe();
+  t.voxels = std::move(needed);
+  t.sample.resize(n);
+  for (size_t k = 0; k < n; ++k)  // the nearest voxel is always a tap with a non-zero weight
+    t.sample[k] = uint32_t(std::lower_bound(t.voxels.begin(), t.voxels.end(), nearest[k]) - t.voxels.begin());
+  return t;
+}
+
+std::vector<std::array<float, 3>> TargetSet::resolve(const std::vector<std::array<float, 3>>& voxel_rgb) const {
+  std::vector<std::array<float, 3>> out(sample.size());
+  if (resample_floor.empty()) {
+    for (size_t s = 0; s < sample.size(); ++s) out[s] = voxel_rgb[sample[s]];
+    return out;
+  }
+  for (size_t s = 0; s < sample.size(); ++s) {
+    std::array<float, 3> sum{0.f, 0.f, 0.f};
+    std::array<float, 3> lo = voxel_rgb[sample[s]], hi = lo;
+    for_each_tap(resample_floor[s], resample_t[s], [&](const Voxel& q, float w) {
+      const auto& c = voxel_rgb[size_t(std::lower_bound(voxels.begin(), voxels.end(), q) - voxels.begin())];
+      for (size_t ch = 0; ch < 3; ++ch) {
+        sum[ch] += w * c[ch];
+        lo[ch] = std::min(lo[ch], c[ch]);
+        hi[ch] = std::max(hi[ch], c[ch]);
+      }
+    });
+    for (size_t ch = 0; ch < 3; ++ch) out[s][ch] = std::clamp(sum[ch], lo[ch], hi[ch]);
+  }
+  return out;
 }
 
 Result<TargetSet> TargetSet::box(const Voxel& min, int sx, int sy, int sz) {

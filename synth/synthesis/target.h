@@ -1,9 +1,19 @@
 // What a request asks for: finest-level voxels, and how output samples map onto them.
-// Axis cuts index finest voxels directly; plane cuts and points round world positions
-// (world unit = finest voxel) to the nearest voxel with std::lround per axis.
+// Axis cuts and boxes index finest voxels directly; points round world positions (world unit =
+// finest voxel) to the nearest voxel with std::lround per axis, and so do plane cuts by default.
+// Plane cuts may resample instead (PlaneSampling::kCubic): a pixel is the Catmull-Rom (tricubic,
+// interpolating) combination of the 4x4x4 finest voxels around its world position, clamped to
+// their range (no ringing). Nearest voxels skip and repeat along a tilted plane (rotating a z
+// cut by 37 degrees that way raised its swd 40-48 %, bicubically 1-4 %); cubic removes those
+// jaggies but softens 1-voxel detail, and measured on the shared exemplars it is better on half
+// of them and worse on the other half (README, Quality), hence opt-in. At integer positions
+// the weights are exactly (0, 1, 0, 0): either way a plane cut along the axes equals the axis
+// cut bit for bit. Output colours are a pure function of the voxels' colours, hence of position.
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "core/status.h"
@@ -14,19 +24,32 @@ namespace solidtex {
 
 inline constexpr int64_t kMaxTargetSamples = int64_t(1) << 24;
 
+enum class PlaneSampling {
+  kNearest,  // the voxel nearest each pixel's position (default)
+  kCubic,    // Catmull-Rom resampling of the 4x4x4 voxels around it (above)
+};
+Result<PlaneSampling> parse_plane_sampling(const std::string& name);  // "nearest" | "cubic"
+
 struct TargetSet {
   std::vector<Voxel> voxels;        // distinct finest voxels, sorted
-  std::vector<uint32_t> sample;     // output sample -> index into voxels
+  std::vector<uint32_t> sample;     // output sample -> index into voxels (its nearest voxel)
+  // Resampled targets (plane cuts) only, else empty (`sample` is exact): sample s lies at
+  // resample_floor[s] + resample_t[s] (t in [0, 1) per axis); its taps are the voxels
+  // floor - 1 .. floor + 2 per axis that have a non-zero weight, all in `voxels`.
+  std::vector<Voxel> resample_floor;
+  std::vector<std::array<float, 3>> resample_t;
   int width = 0;                    // output shape: width*height samples (points: count x 1)
   int height = 0;
   VoxelBox bounds() const;
+  // Output samples' colours from the colours of `voxels` (same order).
+  std::vector<std::array<float, 3>> resolve(const std::vector<std::array<float, 3>>& voxel_rgb) const;
 
   // Pixel (i, j) of a cut: axis z -> (u0+i, v0+j, at); axis x -> (at, u0+i, v0+j);
   // axis y -> (u0+i, at, v0+j).
   static Result<TargetSet> axis_cut(char axis, int at, int u0, int v0, int width, int height);
-  // Pixel (i, j) -> lround(origin + i*u + j*v), all in voxel units.
+  // Pixel (i, j) -> origin + i*u + j*v, all in voxel units, sampled as `sampling` says.
   static Result<TargetSet> plane_cut(const WorldPoint& origin, const WorldPoint& u, const WorldPoint& v, int width,
-                                     int height);
+                                     int height, PlaneSampling sampling = PlaneSampling::kNearest);
   // Every voxel of the box [min, min+size), x fastest, then y, then z (height = size.y*size.z).
   static Result<TargetSet> box(const Voxel& min, int sx, int sy, int sz);
   static Result<TargetSet> points(const std::vector<WorldPoint>& points);

@@ -146,6 +146,19 @@ def test_cut_matches_cli_plane_and_slice(shared, tmp_path):
     # an axis-aligned cut is the slice
     flat = c.cut(vid, origin=(0, 0, 3), u=(1, 0, 0), v=(0, 1, 0), size=(32, 24), dtype="float32")
     assert np.array_equal(flat, c.slice(vid, "z", 3, (32, 24), dtype="float32"))
+    # cubic resampling: the same bytes from the service and the CLI, different from nearest,
+    # exactly the slice along the axes; any other name is a 400 naming the field
+    cubic = c.cut(vid, resample="cubic", **OBLIQUE)
+    assert cubic.shape == u8.shape and not np.array_equal(cubic, u8)
+    out_cubic = tmp_path / "cubic.png"
+    run_cli("slice", shared.table_path, "--plane", plane, "--resample", "cubic", "--size", "32,24", "--seed", "7",
+            "-o", out_cubic)
+    assert np.array_equal(file_pixels(out_cubic), cubic), "service cubic cut != CLI --plane --resample cubic"
+    flat_cubic = c.cut(vid, origin=(0, 0, 3), u=(1, 0, 0), v=(0, 1, 0), size=(32, 24), dtype="float32", resample="cubic")
+    assert np.array_equal(flat_cubic, flat)
+    r = requests.post(f"{shared.server.url}/v1/volumes/{vid}/cut", json={**{k: list(v) for k, v in OBLIQUE.items()}, "resample": "lanczos"},
+                      timeout=60)
+    assert r.status_code == 400 and r.json()["error"]["field"] == "resample", r.text
 
 
 def test_scale_slice_and_cut_are_the_raw_routes_bytes(shared):
