@@ -25,15 +25,17 @@ void check_table(const Table& t) {
       FUZZ_CHECK(app.stack.width == img.width && app.stack.height == img.height);
       FUZZ_CHECK(app.pca.output_dims >= 1 && app.pca.output_dims <= app.pca.input_dims);
       FUZZ_CHECK(app.projected.size() == size_t(img.pixel_count()) * size_t(app.pca.output_dims));
-      const PlaneCandidates& pc = level.candidates.planes[size_t(k)];
+      const PlaneCandidates& pc = level.candidates->planes[size_t(k)];
       FUZZ_CHECK(pc.width == img.width && pc.height == img.height);
       FUZZ_CHECK(pc.per_pixel == t.params().candidates);
-      FUZZ_CHECK(pc.counts.size() == size_t(img.pixel_count()));
-      FUZZ_CHECK(pc.triples.size() == size_t(img.pixel_count()) * size_t(pc.per_pixel));
-      for (size_t i = 0; i < pc.counts.size(); ++i) {
-        FUZZ_CHECK(pc.counts[i] <= pc.per_pixel);
-        for (int j = 0; j < pc.counts[i]; ++j) {
-          const CoordinateTriple& tr = pc.triples[i * size_t(pc.per_pixel) + size_t(j)];
+      FUZZ_CHECK(pc.counts && pc.triples);
+      FUZZ_CHECK(pc.counts->size() == size_t(img.pixel_count()));
+      FUZZ_CHECK(pc.triples->size() == size_t(img.pixel_count()) * size_t(pc.per_pixel));
+      for (size_t i = 0; i < pc.counts->size(); ++i) {
+        FUZZ_CHECK((*pc.counts)[i] <= pc.per_pixel);
+        const CandidateList list = pc.at({int(i % size_t(img.width)), int(i / size_t(img.width))});
+        FUZZ_CHECK(list.size() == (*pc.counts)[i]);
+        for (const CoordinateTriple& tr : list) {
           FUZZ_CHECK(tr.at[size_t(k)].x == int32_t(i % size_t(img.width)) && tr.at[size_t(k)].y == int32_t(i / size_t(img.width)));
           for (int p = 0; p < 3; ++p) {
             const ImageF& other = ex.plane(plane_from_index(p));
