@@ -192,7 +192,7 @@ S = {
      "u": {**vec3, "description": "Step per output column, in voxels of dataset `scale`."},
      "v": {**vec3, "description": "Step per output row, in voxels of dataset `scale`."},
      "size": {"type": "array", "items": integer(1, MAX_CUT_SIDE), "minItems": 2, "maxItems": 2, "description": "W, H."},
-     "resample": {"type": "string", "enum": ["nearest", "cubic"], "default": "nearest", "description": "nearest: each pixel is the voxel nearest its position. cubic: the Catmull-Rom (tricubic) combination of the 4x4x4 voxels around it, clamped to their range: no jaggies along tilted planes, softer 1-voxel detail. At integer positions both give that voxel."}}},
+     "resample": {"type": "string", "enum": ["nearest", "cubic"], "default": "nearest", "description": "nearest: each pixel is the voxel nearest its position. cubic: the Catmull-Rom (tricubic) combination of the 4x4x4 voxels around it, clamped to their range: no jaggies along tilted planes, softer 1-voxel detail; at most 1024^2 pixels reading at most 8 Mi voxels (else 422 naming size). At integer positions both give that voxel."}}},
  "PointsRequest": {"type": "object", "additionalProperties": False, "required": ["points"], "properties": {
      "points": {"type": "array", "minItems": 1, "items": vec3, "description": "World points; at most --max-voxels of them (else 422)."}}},
  "Mesh": {"type": "object", "required": ["id"], "properties": {

@@ -113,6 +113,11 @@ Result<TargetSet> TargetSet::plane_cut(const WorldPoint& o, const WorldPoint& u,
     return from_voxels(s, width, height);
   }
   const size_t n = size_t(width) * height;
+  if (int64_t(n) > kMaxResampledSamples)
+    return Status(StatusCode::kTooLarge,
+                  "cubic resampling takes at most " + std::to_string(kMaxResampledSamples) +
+                      " pixels; use resample nearest or a smaller cut",
+                  "size");
   TargetSet t;
   t.width = width;
   t.height = height;
@@ -120,15 +125,28 @@ Result<TargetSet> TargetSet::plane_cut(const WorldPoint& o, const WorldPoint& u,
   t.resample_t.resize(n);
   std::vector<Voxel> nearest(n), needed;
   // Neighbouring samples share most of their 4x4x4 taps: deduplicate as the list grows, so
-  // memory stays near the distinct voxels (a slab ~5 voxels thick), not 64 per sample.
+  // memory stays near the distinct voxels (a slab ~5 voxels thick), not 64 per sample. Sparse
+  // cuts (steps of several voxels, lines) share nothing: past kMaxResampledVoxels distinct
+  // voxels the cut is refused before more memory is spent (transient <= 2x that + 1 Mi voxels).
   size_t distinct = 0;
-  auto dedupe = [&] {
-    std::sort(needed.begin(), needed.end());
+  auto dedupe = [&] {  // needed[0, distinct) is sorted and distinct: sort the tail and merge
+    const auto mid = needed.begin() + std::ptrdiff_t(distinct);
+    std::sort(mid, needed.end());
+    needed.erase(std::unique(mid, needed.end()), needed.end());
+    std::inplace_merge(needed.begin(), needed.begin() + std::ptrdiff_t(distinct), needed.end());
     needed.erase(std::unique(needed.begin(), needed.end()), needed.end());
     distinct = needed.size();
   };
   for (int j = 0; j < height; ++j) {
     for (int i = 0; i < width; ++i) {
+      if (needed.size() > 2 * distinct + (size_t(1) << 20)) {
+        dedupe();
+        if (distinct > size_t(kMaxResampledVoxels))
+          return Status(StatusCode::kTooLarge,
+                        "cubic resampling of this cut needs more than " + std::to_string(kMaxResampledVoxels) +
+                            " voxels (its pixels lie far apart); use resample nearest or a denser, smaller cut",
+                        "size");
+      }
       const size_t k = size_t(j) * width + i;
       const double p[3] = {o.x + i * u.x + j * v.x, o.y + i * u.y + j * v.y, o.z + i * u.z + j * v.z};
       int fl[3];
@@ -141,9 +159,13 @@ Result<TargetSet> TargetSet::plane_cut(const WorldPoint& o, const WorldPoint& u,
       nearest[k] = {int(std::lround(p[0])), int(std::lround(p[1])), int(std::lround(p[2]))};
       for_each_tap(t.resample_floor[k], t.resample_t[k], [&](const Voxel& q, float) { needed.push_back(q); });
     }
-    if (needed.size() > 4 * distinct + (size_t(1) << 20)) dedupe();
   }
   dedupe();
+  if (distinct > size_t(kMaxResampledVoxels))
+    return Status(StatusCode::kTooLarge,
+                  "cubic resampling of this cut needs more than " + std::to_string(kMaxResampledVoxels) +
+                      " voxels; use resample nearest or a smaller cut",
+                  "size");
   t.voxels = std::move(needed);
   t.sample.resize(n);
   for (size_t k = 0; k < n; ++k)  // the nearest voxel is always a tap with a non-zero weight

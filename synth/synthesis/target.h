@@ -23,6 +23,11 @@
 namespace solidtex {
 
 inline constexpr int64_t kMaxTargetSamples = int64_t(1) << 24;
+// Cubic-resampled plane cuts: at most this many pixels (1024^2), and distinct voxels read (8 Mi:
+// a unit-step 1024^2 oblique cut reads ~5 Mi, one with pixels 5 voxels apart 64 per pixel);
+// more is kTooLarge naming "size", found within a second or two.
+inline constexpr int64_t kMaxResampledSamples = int64_t(1) << 20;
+inline constexpr int64_t kMaxResampledVoxels = int64_t(1) << 23;
 
 enum class PlaneSampling {
   kNearest,  // the voxel nearest each pixel's position (default)

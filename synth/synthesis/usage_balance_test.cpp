@@ -4,6 +4,7 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <limits>
 
 #include "analysis/analysis.h"
 #include "synthesis/synthesizer.h"
@@ -100,9 +101,15 @@ TEST(UsageBalance, FineGainScalesOnlyTheFinerLevelsOfIsotropicTables) {
       }
   }
   EXPECT_TRUE(any_positive);  // the finer levels have penalties to scale
-  UsageBalanceParams bad = small_balance();
-  bad.fine_gain = 5.f;
-  EXPECT_EQ(bad.validate().field(), "fine_gain");
+  UsageBalanceParams edge = small_balance();
+  for (float g : {0.25f, 4.f}) {
+    edge.fine_gain = g;
+    EXPECT_TRUE(edge.validate().is_ok()) << g;
+  }
+  for (float g : {0.2f, 5.f, std::numeric_limits<float>::quiet_NaN()}) {
+    edge.fine_gain = g;
+    EXPECT_EQ(edge.validate().field(), "fine_gain") << g;
+  }
 }
 
 TEST(UsageBalance, ParametersAreValidatedAndCancellationIsClean) {

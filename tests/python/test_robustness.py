@@ -209,6 +209,35 @@ def test_cut_with_huge_steps_is_answered_not_a_500(srv):
     alive(srv)
 
 
+def test_cut_resample_takes_its_two_names_only_and_cubic_is_bounded(srv):
+    # nearest (default) and cubic answer and differ on a tilted plane; any other value is a 400
+    # naming resample; cubic cuts whose pixels lie far apart (64 voxels each) or that are huge
+    # are refused at once with a 422, never allocated; the process stays up
+    vid = create_volume(srv).json()["id"]
+    url = f"{srv.url}/v1/volumes/{vid}/cut"
+    tilted = {"origin": [0.3, 0.2, 0.1], "u": [0.6, 0.8, 0], "v": [-0.48, 0.36, 0.8], "size": [8, 8]}
+    got = {}
+    for name in ("nearest", "cubic"):
+        r = requests.post(url, json={**tilted, "resample": name}, headers=RAW_F32, timeout=HTTP_TIMEOUT)
+        assert r.status_code == 200, r.text
+        got[name] = r.content
+    assert got["nearest"] != got["cubic"]
+    assert requests.post(url, json=tilted, headers=RAW_F32, timeout=HTTP_TIMEOUT).content == got["nearest"]
+    for bad in ("Cubic", "", "lanczos", 1, None, ["cubic"]):
+        r = requests.post(url, json={**tilted, "resample": bad}, headers=RAW_F32, timeout=HTTP_TIMEOUT)
+        assert_error(r, 400, "invalid_argument", "resample")
+    for size, u in (([200000, 4], [5, 0.3, 0]), ([1025, 1024], [0.6, 0.8, 0])):
+        t0 = time.monotonic()
+        r = requests.post(url, json={**tilted, "u": u, "size": size, "resample": "cubic"}, params={"timeout": 5},
+                          headers=RAW_F32, timeout=HTTP_TIMEOUT)
+        assert_error(r, 422, field_contains="size")
+        assert time.monotonic() - t0 < 5
+    r = requests.post(url, json={"origin": [0, 0, 0], "u": [1e8, 0, 0], "v": [0, 1, 0], "size": [2, 1], "resample": "cubic"},
+                      headers=RAW_F32, timeout=HTTP_TIMEOUT)
+    assert r.status_code in (200, 400, 422), r.text
+    alive(srv)
+
+
 def test_overflowing_field_grid_is_refused(srv):
     sketch = {"domain": {"min": [0, 0, 0], "max": [1.1e9, 1, 1]},
               "curves": [{"axis": "x", "plane_normal": [0, 0, 1], "points": [[0, 0, 0], [10, 0.5, 0.5]]}]}
