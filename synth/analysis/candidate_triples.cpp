@@ -124,7 +124,6 @@ Result<CrossbarSearch> prepare_crossbar_search(const PlaneStacks& stacks, const 
   CrossbarSearch search;
   search.stacks = stacks;
   search.layout = layout;
-  search.shared = layout == kSharedLayout;
   search.spacing = spacing;
   // Indices: first-axis lines and second-axis lines of each base image.
   for (int b = 0; b < 3; ++b) {
@@ -193,7 +192,7 @@ Result<LevelCandidates> compute_level_candidates(const CrossbarSearch& search, c
                                                  const std::function<bool(double)>& progress) {
   const PlaneStacks& stacks = search.stacks;
   const PlaneLayout& layout = search.layout;
-  const bool shared = search.shared;
+  const bool shared = search.shared();
   const int spacing = search.spacing;
   const int nt = params.candidates;
   const int keep = 2 * nt;

@@ -191,7 +191,7 @@ struct CrossbarSearch {
   };
   PlaneStacks stacks{};
   PlaneLayout layout = kDistinctLayout;
-  bool shared = false;                  // layout == kSharedLayout
+  bool shared() const { return layout == kSharedLayout; }
   int spacing = 1;
   std::array<Lines, 3> lines;           // per base image (index = base; others empty)
   std::array<std::optional<KnnIndex>, 3> first_index;   // per base image: its first-axis lines
