@@ -137,15 +137,17 @@ Result<TargetSet> TargetSet::plane_cut(const WorldPoint& o, const WorldPoint& u,
     needed.erase(std::unique(needed.begin(), needed.end()), needed.end());
     distinct = needed.size();
   };
+  auto too_many_voxels = [] {
+    return Status(StatusCode::kTooLarge,
+                  "cubic resampling of this cut needs more than " + std::to_string(kMaxResampledVoxels) +
+                      " voxels; use resample nearest, or a smaller cut with pixels closer together",
+                  "size");
+  };
   for (int j = 0; j < height; ++j) {
     for (int i = 0; i < width; ++i) {
       if (needed.size() > 2 * distinct + (size_t(1) << 20)) {
         dedupe();
-        if (distinct > size_t(kMaxResampledVoxels))
-          return Status(StatusCode::kTooLarge,
-                        "cubic resampling of this cut needs more than " + std::to_string(kMaxResampledVoxels) +
-                            " voxels (its pixels lie far apart); use resample nearest or a denser, smaller cut",
-                        "size");
+        if (distinct > size_t(kMaxResampledVoxels)) return too_many_voxels();
       }
       const size_t k = size_t(j) * width + i;
       const double p[3] = {o.x + i * u.x + j * v.x, o.y + i * u.y + j * v.y, o.z + i * u.z + j * v.z};
@@ -161,11 +163,7 @@ Result<TargetSet> TargetSet::plane_cut(const WorldPoint& o, const WorldPoint& u,
     }
   }
   dedupe();
-  if (distinct > size_t(kMaxResampledVoxels))
-    return Status(StatusCode::kTooLarge,
-                  "cubic resampling of this cut needs more than " + std::to_string(kMaxResampledVoxels) +
-                      " voxels; use resample nearest or a smaller cut",
-                  "size");
+  if (distinct > size_t(kMaxResampledVoxels)) return too_many_voxels();
   t.voxels = std::move(needed);
   t.sample.resize(n);
   for (size_t k = 0; k < n; ++k)  // the nearest voxel is always a tap with a non-zero weight
