@@ -6,7 +6,7 @@ Embark's 2D texture-synthesis on the same exemplar and size.
                   [--typicality T]   (synthesis' typicality weight; default: the CLI's default)
                   [--seeds 1,2,3]    (volume seeds; a single cut's swd varies by seed, so an
                                       exemplar's score is its worst-of-four swd averaged over them)
-                  [--resample nearest|cubic] (the oblique cut's sampling; default nearest)
+                  [--resample auto|nearest|cubic] (the oblique cut's sampling; default auto)
                   [--analyze-args "--grain crossed"] (extra analyze flags, for the exemplars
                                       not analysed with --grain x)
                   [--embark-cache F] (Embark's scores per exemplar and size, kept in F and reused:
@@ -92,7 +92,7 @@ def main() -> int:
     ap.add_argument("--slice-args", default="", help="extra `solidtex slice` flags, e.g. \"--passes 1\"")
     ap.add_argument("--analyze-args", default="",
                     help="extra `solidtex analyze` flags for the exemplars analysed with defaults, e.g. \"--grain crossed\"")
-    ap.add_argument("--resample", default="nearest", choices=["nearest", "cubic"],
+    ap.add_argument("--resample", default="auto", choices=["auto", "nearest", "cubic"],
                     help="how the oblique cut samples the voxels (solidtex slice --resample)")
     ap.add_argument("--seeds", default="1", help="comma-separated volume seeds")
     ap.add_argument("--embark-cache", type=Path, default=None)
@@ -141,7 +141,10 @@ def main() -> int:
                     seconds = time.monotonic() - t0
                     scores = texmetric(python, image, ex)
                     scores["seconds"] = round(seconds, 2)
-                    scores["voxels"] = json.loads(stats.read_text())["voxels"]
+                    st = json.loads(stats.read_text())
+                    scores["voxels"] = st["voxels"]
+                    if "resample" in st:  # plane cuts: what --resample (auto) sampled
+                        scores["resample"] = st["resample"]
                     per_seed[cut] = scores
                     if seed == seeds[0]:
                         images.append(image)

@@ -1,4 +1,4 @@
-// solidtex slice TABLE.stx (--axis x|y|z --at K --origin U,V | --plane OX,OY,OZ,UX,UY,UZ,VX,VY,VZ [--resample nearest|cubic])
+// solidtex slice TABLE.stx (--axis x|y|z --at K --origin U,V | --plane OX,OY,OZ,UX,UY,UZ,VX,VY,VZ [--resample auto|nearest|cubic])
 //   --size W,H [--scheme plain|subpass|grid|dual-grid] [--field identity|quat:W,X,Y,Z|axis:..|FILE]
 //   [--seed S] [--threads T] [--passes P] [--coarse-passes P] [--cell M] -o OUT.png [--stats STATS.json]
 #include <nlohmann/json.hpp>
@@ -37,32 +37,52 @@ nlohmann::json stats_json(const SynthesisStats& s) {
           {"estimated_bytes", s.estimated_bytes}};
 }
 
-Result<TargetSet> parse_cut(const Args& args) {
+// The cut the options name, checked before any table loads; built once the tables are known
+// (--resample auto, the default, takes their preferred_plane_sampling).
+struct CutArgs {
+  int width = 0, height = 0;
+  bool plane = false;
+  std::vector<double> plane_vectors;      // --plane: origin, u, v
+  std::optional<PlaneSampling> resample;  // --plane only; nullopt: auto
+  char axis = 'z';
+  int at = 0;
+  std::vector<double> origin{0, 0};
+};
+
+Result<CutArgs> parse_cut(const Args& args) {
+  CutArgs c;
   SOLIDTEX_ASSIGN_OR_RETURN(auto size, args.get_list("--size", 2));
-  const int w = int(size[0]), h = int(size[1]);
-  if (size[0] != w || size[1] != h) return Status(StatusCode::kInvalidArgument, "must be integers", "--size");
+  c.width = int(size[0]);
+  c.height = int(size[1]);
+  if (size[0] != c.width || size[1] != c.height) return Status(StatusCode::kInvalidArgument, "must be integers", "--size");
   if (args.has("--plane")) {
     if (args.has("--axis") || args.has("--at") || args.has("--origin"))
       return Status(StatusCode::kInvalidArgument, "give either --plane or --axis/--at/--origin", "--plane");
-    SOLIDTEX_ASSIGN_OR_RETURN(auto p, args.get_list("--plane", 9));
-    PlaneSampling sampling = PlaneSampling::kNearest;
+    c.plane = true;
+    SOLIDTEX_ASSIGN_OR_RETURN(c.plane_vectors, args.get_list("--plane", 9));
     if (args.has("--resample")) {
       SOLIDTEX_ASSIGN_OR_RETURN(std::string name, args.required("--resample"));
-      auto parsed = parse_plane_sampling(name);
-      if (!parsed) return Status(StatusCode::kInvalidArgument, "must be nearest or cubic", "--resample");
-      sampling = *parsed;
+      SOLIDTEX_ASSIGN_OR_RETURN(c.resample, parse_plane_sampling(name, "--resample"));
     }
-    return TargetSet::plane_cut({p[0], p[1], p[2]}, {p[3], p[4], p[5]}, {p[6], p[7], p[8]}, w, h, sampling);
+    return c;
   }
   if (args.has("--resample")) return Status(StatusCode::kInvalidArgument, "applies to --plane cuts only", "--resample");
   SOLIDTEX_ASSIGN_OR_RETURN(std::string axis, args.required("--axis"));
   if (axis.size() != 1) return Status(StatusCode::kInvalidArgument, "must be x, y or z", "--axis");
-  SOLIDTEX_ASSIGN_OR_RETURN(int at, args.get_int("--at", 0, -(1 << 28), 1 << 28));
-  std::vector<double> origin{0, 0};
+  c.axis = axis[0];
+  SOLIDTEX_ASSIGN_OR_RETURN(c.at, args.get_int("--at", 0, -(1 << 28), 1 << 28));
   if (args.has("--origin")) {
-    SOLIDTEX_ASSIGN_OR_RETURN(origin, args.get_list("--origin", 2));
+    SOLIDTEX_ASSIGN_OR_RETURN(c.origin, args.get_list("--origin", 2));
   }
-  return TargetSet::axis_cut(axis[0], at, int(origin[0]), int(origin[1]), w, h);
+  return c;
+}
+
+// `preferred`: the sampling auto stands for.
+Result<TargetSet> build_cut(const CutArgs& c, PlaneSampling preferred) {
+  if (!c.plane) return TargetSet::axis_cut(c.axis, c.at, int(c.origin[0]), int(c.origin[1]), c.width, c.height);
+  const auto& p = c.plane_vectors;
+  return TargetSet::plane_cut({p[0], p[1], p[2]}, {p[3], p[4], p[5]}, {p[6], p[7], p[8]}, c.width, c.height, c.resample,
+                              preferred);
 }
 
 Status run_slice(const std::vector<std::string>& argv) {
@@ -74,7 +94,7 @@ Status run_slice(const std::vector<std::string>& argv) {
   if (args.positionals().size() != 1)
     return Status(StatusCode::kInvalidArgument, "expects exactly one TABLE.stx", "table");
   SOLIDTEX_ASSIGN_OR_RETURN(std::string out, args.required("-o"));
-  SOLIDTEX_ASSIGN_OR_RETURN(TargetSet target, parse_cut(args));
+  SOLIDTEX_ASSIGN_OR_RETURN(const CutArgs cut, parse_cut(args));
   SynthesisParams params;
   if (auto s = args.get("--scheme")) {
     SOLIDTEX_ASSIGN_OR_RETURN(params.scheme, parse_scheme(*s));
@@ -110,15 +130,24 @@ Status run_slice(const std::vector<std::string>& argv) {
   SOLIDTEX_ASSIGN_OR_RETURN(int cache_mb, args.get_int("--cache-mb", 256, 0, 1 << 20));
   SOLIDTEX_ASSIGN_OR_RETURN(auto field, parse_field_spec(args.get("--field").value_or("identity")));
   SOLIDTEX_ASSIGN_OR_RETURN(auto synth, Synthesizer::create(table, field, params, int64_t(cache_mb) << 20));
+  if (args.has("--region-table") != args.has("--regions"))
+    return Status(StatusCode::kInvalidArgument, "--region-table and --regions go together", "--regions");
+  std::vector<std::shared_ptr<const Table>> tables{table};
+  if (auto second = args.get("--region-table")) {
+    SOLIDTEX_ASSIGN_OR_RETURN(auto table2, load_table(*second));
+    tables.push_back(table2);
+  }
+  std::vector<const Table*> cut_tables;
+  for (const auto& t : tables) cut_tables.push_back(t.get());
+  const PlaneSampling preferred = preferred_plane_sampling(cut_tables);
+  SOLIDTEX_ASSIGN_OR_RETURN(const TargetSet target, build_cut(cut, preferred));
   ProgressBar bar;
   SynthesisStats stats;
   std::vector<std::array<float, 3>> rgb;
-  if (args.has("--region-table") != args.has("--regions"))
-    return Status(StatusCode::kInvalidArgument, "--region-table and --regions go together", "--regions");
-  if (auto second = args.get("--region-table")) {
+  if (tables.size() == 2) {
     // Label 1 of --regions takes the second table's texture (same field and parameters).
     SOLIDTEX_ASSIGN_OR_RETURN(auto label, RegionLabel::parse(*args.get("--regions")));
-    SOLIDTEX_ASSIGN_OR_RETURN(auto table2, load_table(*second));
+    const auto& table2 = tables[1];
     SynthesisParams p2 = params;
     if (!args.has("--plane-weights")) p2.plane_weights = table2->params().suggested_plane_weights;
     SOLIDTEX_ASSIGN_OR_RETURN(auto synth2, Synthesizer::create(table2, field, p2, int64_t(cache_mb) << 20));
@@ -141,6 +170,7 @@ Status run_slice(const std::vector<std::string>& argv) {
   j["scheme"] = scheme_name(params.scheme);
   j["matcher"] = matcher_name(params.matcher);
   j["field"] = field->describe();
+  if (cut.plane) j["resample"] = plane_sampling_name(target.sampling());
   if (args.has("--energy")) {
     // Neighborhood-matching energy of the cut against exemplar xy (quality.h).
     j["energy"] = neighborhood_energy(img, table->exemplars().plane(Plane::kXY), table->params().neighborhood, 2);

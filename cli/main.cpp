@@ -30,7 +30,7 @@ constexpr const char* kUsage =
     "          [--balance-strength 0.025] [--balance-fine-gain 2]\n"
     "          -o TABLE.stx [--json]\n"
     "  slice TABLE.stx (--axis x|y|z --at K [--origin U,V] | --plane OX,OY,OZ,UX,UY,UZ,VX,VY,VZ\n"
-    "          [--resample nearest|cubic])\n"
+    "          [--resample auto|nearest|cubic])\n"
     "          --size W,H [--scheme plain|subpass|grid|dual-grid] [--field identity|quat:W,X,Y,Z|FILE]\n"
     "          [--seed S] [--threads T] [--typicality 0.5] [--balance 1] [--init auto|scatter|slab] [--color medoid|mean]\n"
     "          [--finest-subpass-size 1|2] [--stats STATS.json] -o OUT.png\n"

@@ -192,7 +192,7 @@ S = {
      "u": {**vec3, "description": "Step per output column, in voxels of dataset `scale`."},
      "v": {**vec3, "description": "Step per output row, in voxels of dataset `scale`."},
      "size": {"type": "array", "items": integer(1, MAX_CUT_SIDE), "minItems": 2, "maxItems": 2, "description": "W, H."},
-     "resample": {"type": "string", "enum": ["nearest", "cubic"], "default": "nearest", "description": "nearest: each pixel is the voxel nearest its position. cubic: the Catmull-Rom (tricubic) combination of the 4x4x4 voxels around it, clamped to their range: no jaggies along tilted planes, softer 1-voxel detail; at most 1024^2 pixels reading at most 8 Mi voxels (else 422 naming size). At integer positions both give that voxel."}}},
+     "resample": {"type": "string", "enum": ["auto", "nearest", "cubic"], "default": "auto", "description": "nearest: each pixel is the voxel nearest its position. cubic: the Catmull-Rom (tricubic) combination of the 4x4x4 voxels around it, clamped to their range: no jaggies along tilted planes, softer 1-voxel detail; at most 1024^2 pixels reading at most 8 Mi voxels (else 422 naming size). auto: cubic when the volume's exemplars carry little 1-pixel detail (every exemplar's finest Laplacian band under 43 % of its two finest bands' energy), else nearest; the answer's X-Resample header says which. At integer positions all give that voxel."}}},
  "PointsRequest": {"type": "object", "additionalProperties": False, "required": ["points"], "properties": {
      "points": {"type": "array", "minItems": 1, "items": vec3, "description": "World points; at most --max-voxels of them (else 422)."}}},
  "Mesh": {"type": "object", "required": ["id"], "properties": {
@@ -314,10 +314,11 @@ paths = {
      "description": IMMUTABLE_IMAGE + " " + RANGED,
      "responses": {"200": image_out, **IMAGE_RANGE_OUT, **errs("400", "404", "422", "503", "504")}}},
  "/v1/volumes/{id}/cut": {"parameters": [pid()],
-   "post": {"operationId": "cut", "summary": "Arbitrary planar cut: pixel (i, j) is the voxel of dataset `scale` (the finest voxels by default) nearest origin + i*u + j*v, all in that dataset's voxels, or with `resample` cubic their Catmull-Rom resampling around that position.", "parameters": [scale_param, timeout],
+   "post": {"operationId": "cut", "summary": "Arbitrary planar cut: pixel (i, j) is the voxel of dataset `scale` (the finest voxels by default) nearest origin + i*u + j*v, all in that dataset's voxels, or with `resample` cubic their Catmull-Rom resampling around that position (`resample` auto, the default, picks per volume).", "parameters": [scale_param, timeout],
      "requestBody": {"required": True, "content": {"application/json": {"schema": ref("Cut")}}},
      "description": IMMUTABLE_IMAGE,
-     "responses": {"200": image_out, **errs("400", "404", "413", "415", "422", "503", "504")}}},
+     "responses": {"200": {**image_out, "headers": {**image_out["headers"], "X-Resample": {"schema": {"type": "string", "enum": ["nearest", "cubic"]}, "description": "How the pixels sampled the voxels (what `resample` auto stood for)."}}},
+                   **errs("400", "404", "413", "415", "422", "503", "504")}}},
  "/v1/volumes/{id}/region": {"parameters": [pid()],
    "get": {"operationId": "region", "summary": "A box of voxels; W*H*D at most --max-voxels (else 422). Default: an OpenVDB file with one Vec3s grid 'color' (linear RGB, index space = finest voxels). `Accept: application/octet-stream` gives raw sRGB8 (D x H x W x 3, x fastest), `; dtype=float32` raw linear float32.",
      "parameters": [qlist("min", "X,Y,Z voxel indices, each in [-2^28, 2^28 - 2^24].", integer(-MAX_COORD, MAX_ORIGIN), 3, True),

@@ -512,13 +512,20 @@ HttpResponse Api::cut(const HttpRequest& r) {
     SOLIDTEX_ASSIGN_OR_RETURN(int64_t h, json_int(j["size"][1], "size", 1, kMaxCutSide));
     SOLIDTEX_RETURN_IF_ERROR(volumes_.check_target_size(w * h, "size"));
     SOLIDTEX_ASSIGN_OR_RETURN(const int level, level_of_scale(r, q));
-    PlaneSampling sampling = PlaneSampling::kNearest;
+    std::optional<PlaneSampling> requested;  // auto
     if (j.contains("resample")) {
-      if (!j["resample"].is_string()) return Status(StatusCode::kInvalidArgument, "must be nearest or cubic", "resample");
-      SOLIDTEX_ASSIGN_OR_RETURN(sampling, parse_plane_sampling(j["resample"].get<std::string>()));
+      if (!j["resample"].is_string())
+        return Status(StatusCode::kInvalidArgument, "must be auto, nearest or cubic", "resample");
+      SOLIDTEX_ASSIGN_OR_RETURN(requested, parse_plane_sampling(j["resample"].get<std::string>(), "resample"));
     }
-    SOLIDTEX_ASSIGN_OR_RETURN(TargetSet target, TargetSet::plane_cut(origin, u, v, int(w), int(h), sampling));
-    return synthesize_image(r, "cut", target, q.get("timeout"), level);
+    PlaneSampling preferred = PlaneSampling::kNearest;
+    if (!requested) {
+      SOLIDTEX_ASSIGN_OR_RETURN(preferred, volumes_.preferred_plane_sampling(r.param("id")));
+    }
+    SOLIDTEX_ASSIGN_OR_RETURN(TargetSet target, TargetSet::plane_cut(origin, u, v, int(w), int(h), requested, preferred));
+    SOLIDTEX_ASSIGN_OR_RETURN(HttpResponse out, synthesize_image(r, "cut", target, q.get("timeout"), level));
+    out.headers.push_back({"X-Resample", plane_sampling_name(target.sampling())});
+    return out;
   }();
   return result ? *result : HttpResponse::error(result.status());
 }

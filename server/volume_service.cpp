@@ -61,6 +61,7 @@ struct VolumeState {
   std::shared_ptr<const SurfaceDistance> surface;
   std::vector<std::shared_ptr<const Table>> tables;  // distinct; shared with other volumes of the exemplar
   std::vector<int64_t> table_bytes;                  // per entry of `tables`
+  PlaneSampling plane_sampling = PlaneSampling::kNearest;  // what plane cuts' resample "auto" stands for
   int64_t synthesizer_bytes = 0, field_bytes = 0, surface_bytes = 0;
 
   int64_t own_bytes() const { return synthesizer_bytes + field_bytes + surface_bytes; }
@@ -291,6 +292,9 @@ struct VolumeService::Impl {
       SOLIDTEX_ASSIGN_OR_RETURN(st->regions, RegionVolume::create(st->synths, label));
       st->synthesizer_bytes += int64_t(sizeof(RegionVolume));
     }
+    std::vector<const Table*> tables;
+    for (const auto& t : st->tables) tables.push_back(t.get());
+    st->plane_sampling = solidtex::preferred_plane_sampling(tables);
     st->field_bytes = field_resident_bytes(*st->field);
     st->surface_bytes = st->surface ? st->surface->resident_bytes() : 0;
     return st;
@@ -735,6 +739,11 @@ Result<VolumeService::ArrayInfo> VolumeService::array_info(const std::string& id
   out.levels = state->regions ? 1 : state->synths[0]->table().levels();
   out.tag = fnv1a_hex(v->info["spec"].dump());  // the spec's canonical dump (sorted keys)
   return out;
+}
+
+Result<PlaneSampling> VolumeService::preferred_plane_sampling(const std::string& id) {
+  SOLIDTEX_ASSIGN_OR_RETURN(const Impl::Hold held, impl_->hold(id));
+  return held.state->plane_sampling;
 }
 
 Result<QueryResult> VolumeService::query(const std::string& id, const std::string& kind, const TargetSet& target,

@@ -651,11 +651,14 @@ class Client:
 
     def cut(self, volume_id: str, origin: Sequence[float], u: Sequence[float],
             v: Sequence[float], size: Sequence[int], dtype: str = "uint8",
-            timeout: Optional[float] = None, scale: int = 0, resample: str = "nearest") -> Any:
-        """POST /v1/volumes/{id}/cut: a planar cut; pixel (i, j) is the voxel nearest
+            timeout: Optional[float] = None, scale: int = 0, resample: Optional[str] = None) -> Any:
+        """POST /v1/volumes/{id}/cut: a planar cut; pixel (i, j) samples the voxels at
         ``origin + i*u + j*v`` (in voxels of dataset ``scale``: finest voxels for the
-        default 0), ``size`` = (W, H); with ``resample="cubic"`` the Catmull-Rom resampling
-        of the voxels around that position (no jaggies on tilted planes, softer detail).
+        default 0), ``size`` = (W, H). ``resample``: ``"nearest"`` (the voxel nearest that
+        position), ``"cubic"`` (the Catmull-Rom resampling of the voxels around it: no jaggies
+        on tilted planes, softer detail), or ``None``/``"auto"`` (the server picks per volume:
+        cubic when its exemplars carry little 1-pixel detail; the answer's ``X-Resample``
+        header says which).
 
         ``dtype``, ``timeout`` and ``scale`` as for :meth:`slice`.
         """
@@ -663,7 +666,7 @@ class Client:
         scale = _scale(scale)
         body = {"origin": [float(x) for x in origin], "u": [float(x) for x in u],
                 "v": [float(x) for x in v], "size": [int(x) for x in size]}
-        if resample != "nearest":
+        if resample is not None:
             body["resample"] = resample
         r = self._timed("POST", f"/v1/volumes/{volume_id}/cut", timeout, json=body,
                         params={"scale": scale or None}, headers={"Accept": accept})

@@ -89,12 +89,6 @@ Result<TargetSet> TargetSet::axis_cut(char axis, int at, int u0, int v0, int wid
   return from_voxels(s, width, height);
 }
 
-Result<PlaneSampling> parse_plane_sampling(const std::string& name) {
-  if (name == "nearest") return PlaneSampling::kNearest;
-  if (name == "cubic") return PlaneSampling::kCubic;
-  return Status(StatusCode::kInvalidArgument, "must be nearest or cubic", "resample");
-}
-
 Result<TargetSet> TargetSet::plane_cut(const WorldPoint& o, const WorldPoint& u, const WorldPoint& v, int width, int height,
                                        PlaneSampling sampling) {
   SOLIDTEX_RETURN_IF_ERROR(check_size(width, height));
@@ -169,6 +163,16 @@ Result<TargetSet> TargetSet::plane_cut(const WorldPoint& o, const WorldPoint& u,
   for (size_t k = 0; k < n; ++k)  // the nearest voxel is always a tap with a non-zero weight
     t.sample[k] = uint32_t(std::lower_bound(t.voxels.begin(), t.voxels.end(), nearest[k]) - t.voxels.begin());
   return t;
+}
+
+Result<TargetSet> TargetSet::plane_cut(const WorldPoint& o, const WorldPoint& u, const WorldPoint& v, int width, int height,
+                                       std::optional<PlaneSampling> resample, PlaneSampling preferred) {
+  if (resample) return plane_cut(o, u, v, width, height, *resample);
+  if (preferred == PlaneSampling::kCubic) {
+    auto cubic = plane_cut(o, u, v, width, height, PlaneSampling::kCubic);
+    if (cubic || cubic.status().code() != StatusCode::kTooLarge) return cubic;
+  }
+  return plane_cut(o, u, v, width, height, PlaneSampling::kNearest);
 }
 
 std::vector<std::array<float, 3>> TargetSet::resolve(const std::vector<std::array<float, 3>>& voxel_rgb) const {

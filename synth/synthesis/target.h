@@ -1,23 +1,22 @@
 // What a request asks for: finest-level voxels, and how output samples map onto them.
 // Axis cuts and boxes index finest voxels directly; points round world positions (world unit =
-// finest voxel) to the nearest voxel with std::lround per axis, and so do plane cuts by default.
-// Plane cuts may resample instead (PlaneSampling::kCubic): a pixel is the Catmull-Rom (tricubic,
-// interpolating) combination of the 4x4x4 finest voxels around its world position, clamped to
-// their range (no ringing). Nearest voxels skip and repeat along a tilted plane (rotating a z
-// cut by 37 degrees that way raised its swd 40-48 %, bicubically 1-4 %); cubic removes those
-// jaggies but softens 1-voxel detail, and measured on the shared exemplars it is better on half
-// of them and worse on the other half (README, Quality), hence opt-in. At integer positions
-// the weights are exactly (0, 1, 0, 0): either way a plane cut along the axes equals the axis
-// cut bit for bit. Output colours are a pure function of the voxels' colours, hence of position.
+// finest voxel) to the nearest voxel with std::lround per axis. Plane cuts sample as told
+// (plane_sampling.h says which suits an exemplar): the nearest voxel, or the Catmull-Rom
+// (tricubic, interpolating) combination of the 4x4x4 finest voxels around the pixel's world
+// position, clamped to their range (no ringing). At integer positions the cubic weights are
+// exactly (0, 1, 0, 0): either way a plane cut along the axes equals the axis cut bit for bit.
+// Output colours are a pure function of the voxels' colours, hence of position.
 #pragma once
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "core/status.h"
 #include "core/types.h"
+#include "synthesis/plane_sampling.h"
 #include "synthesis/voxel_mask.h"
 
 namespace solidtex {
@@ -28,12 +27,6 @@ inline constexpr int64_t kMaxTargetSamples = int64_t(1) << 24;
 // more is kTooLarge naming "size", found within a second or two.
 inline constexpr int64_t kMaxResampledSamples = int64_t(1) << 20;
 inline constexpr int64_t kMaxResampledVoxels = int64_t(1) << 23;
-
-enum class PlaneSampling {
-  kNearest,  // the voxel nearest each pixel's position (default)
-  kCubic,    // Catmull-Rom resampling of the 4x4x4 voxels around it (above)
-};
-Result<PlaneSampling> parse_plane_sampling(const std::string& name);  // "nearest" | "cubic"
 
 struct TargetSet {
   std::vector<Voxel> voxels;        // distinct finest voxels, sorted
@@ -55,6 +48,13 @@ struct TargetSet {
   // Pixel (i, j) -> origin + i*u + j*v, all in voxel units, sampled as `sampling` says.
   static Result<TargetSet> plane_cut(const WorldPoint& origin, const WorldPoint& u, const WorldPoint& v, int width,
                                      int height, PlaneSampling sampling = PlaneSampling::kNearest);
+  // The same with `resample` auto (nullopt) resolved: `preferred` (plane_sampling.h), or
+  // nearest where a cubic cut would pass the bounds above, so auto never refuses a cut nearest
+  // takes. Given a sampling, exactly that one (and its errors).
+  static Result<TargetSet> plane_cut(const WorldPoint& origin, const WorldPoint& u, const WorldPoint& v, int width,
+                                     int height, std::optional<PlaneSampling> resample, PlaneSampling preferred);
+  // How a plane cut samples: kCubic when it resamples, else kNearest.
+  PlaneSampling sampling() const { return resample_floor.empty() ? PlaneSampling::kNearest : PlaneSampling::kCubic; }
   // Every voxel of the box [min, min+size), x fastest, then y, then z (height = size.y*size.z).
   static Result<TargetSet> box(const Voxel& min, int sx, int sy, int sz);
   static Result<TargetSet> points(const std::vector<WorldPoint>& points);

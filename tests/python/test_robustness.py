@@ -209,20 +209,24 @@ def test_cut_with_huge_steps_is_answered_not_a_500(srv):
     alive(srv)
 
 
-def test_cut_resample_takes_its_two_names_only_and_cubic_is_bounded(srv):
-    # nearest (default) and cubic answer and differ on a tilted plane; any other value is a 400
-    # naming resample; cubic cuts whose pixels lie far apart (64 voxels each) or that are huge
-    # are refused at once with a 422, never allocated; the process stays up
+def test_cut_resample_takes_its_three_names_only_and_cubic_is_bounded(srv):
+    # nearest and cubic answer, say so in X-Resample and differ on a tilted plane; auto (the
+    # default) is one of them; any other value is a 400 naming resample; cubic cuts whose pixels
+    # lie far apart (64 voxels each) or that are huge are refused at once with a 422, never
+    # allocated, and auto samples those nearest instead; the process stays up
     vid = create_volume(srv).json()["id"]
     url = f"{srv.url}/v1/volumes/{vid}/cut"
     tilted = {"origin": [0.3, 0.2, 0.1], "u": [0.6, 0.8, 0], "v": [-0.48, 0.36, 0.8], "size": [8, 8]}
     got = {}
-    for name in ("nearest", "cubic"):
+    for name in ("nearest", "cubic", "auto"):
         r = requests.post(url, json={**tilted, "resample": name}, headers=RAW_F32, timeout=HTTP_TIMEOUT)
         assert r.status_code == 200, r.text
-        got[name] = r.content
-    assert got["nearest"] != got["cubic"]
-    assert requests.post(url, json=tilted, headers=RAW_F32, timeout=HTTP_TIMEOUT).content == got["nearest"]
+        assert r.headers["X-Resample"] == (name if name != "auto" else r.headers["X-Resample"]), r.headers
+        got[name] = (r.headers["X-Resample"], r.content)
+    assert got["nearest"][1] != got["cubic"][1]
+    assert got["auto"][0] in ("nearest", "cubic") and got["auto"][1] == got[got["auto"][0]][1]
+    default = requests.post(url, json=tilted, headers=RAW_F32, timeout=HTTP_TIMEOUT)
+    assert (default.headers["X-Resample"], default.content) == got["auto"]
     for bad in ("Cubic", "", "lanczos", 1, None, ["cubic"]):
         r = requests.post(url, json={**tilted, "resample": bad}, headers=RAW_F32, timeout=HTTP_TIMEOUT)
         assert_error(r, 400, "invalid_argument", "resample")

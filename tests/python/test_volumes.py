@@ -3,12 +3,14 @@
 Each test reads its own far-apart part of the shared volume so that caching by one test does
 not hide synthesis in another.
 """
+import json
+
 import numpy as np
 import pytest
 import requests
 
 from solidtex_client import BadRequest, NotFound, Unprocessable
-from support import RAW, RAW_F32, assert_error, file_pixels, png_pixels, run_cli, solidtex_bin, srgb8
+from support import RAW, RAW_F32, assert_error, file_pixels, png_pixels, run_cli, solidtex_bin, srgb8, upload_ready
 
 OBLIQUE = dict(origin=(1, 2, 3), u=(0.6, 0.8, 0), v=(-0.48, 0.36, 0.8), size=(32, 24))
 
@@ -142,14 +144,16 @@ def test_cut_matches_cli_plane_and_slice(shared, tmp_path):
     plane = ",".join(str(x) for x in (*OBLIQUE["origin"], *OBLIQUE["u"], *OBLIQUE["v"]))
     run_cli("slice", shared.table_path, "--plane", plane, "--size", "32,24", "--seed", "7",
             "-o", out)
-    assert np.array_equal(file_pixels(out), u8), "service cut != CLI --plane"
+    assert np.array_equal(file_pixels(out), u8), "service cut != CLI --plane (both resample auto)"
     # an axis-aligned cut is the slice
     flat = c.cut(vid, origin=(0, 0, 3), u=(1, 0, 0), v=(0, 1, 0), size=(32, 24), dtype="float32")
     assert np.array_equal(flat, c.slice(vid, "z", 3, (32, 24), dtype="float32"))
     # cubic resampling: the same bytes from the service and the CLI, different from nearest,
     # exactly the slice along the axes; any other name is a 400 naming the field
     cubic = c.cut(vid, resample="cubic", **OBLIQUE)
-    assert cubic.shape == u8.shape and not np.array_equal(cubic, u8)
+    nearest = c.cut(vid, resample="nearest", **OBLIQUE)
+    assert cubic.shape == u8.shape and not np.array_equal(cubic, nearest)
+    assert np.array_equal(u8, cubic), "the wood exemplar has little 1-pixel detail: auto is cubic"
     out_cubic = tmp_path / "cubic.png"
     run_cli("slice", shared.table_path, "--plane", plane, "--resample", "cubic", "--size", "32,24", "--seed", "7",
             "-o", out_cubic)
@@ -159,6 +163,36 @@ def test_cut_matches_cli_plane_and_slice(shared, tmp_path):
     r = requests.post(f"{shared.server.url}/v1/volumes/{vid}/cut", json={**{k: list(v) for k, v in OBLIQUE.items()}, "resample": "lanczos"},
                       timeout=60)
     assert r.status_code == 400 and r.json()["error"]["field"] == "resample", r.text
+
+
+def test_auto_resample_follows_the_exemplars_pixel_detail(shared, tmp_path):
+    """`resample` auto, the default, is cubic for an exemplar whose contrast lies above the
+    pixel scale (a smooth wave) and nearest for per-pixel speckle (plane_sampling.h); the answer
+    says which in X-Resample, equals the explicit choice bit for bit, and the CLI's --plane
+    (also auto by default) agrees and reports it in --stats."""
+    c = shared.client
+    yy, xx = np.mgrid[0:48, 0:48]
+    wave = 128 + 80 * np.sin(2 * np.pi * xx / 24) * np.cos(2 * np.pi * yy / 24)
+    images = {"cubic": np.repeat(wave[..., None], 3, axis=2).astype(np.uint8),
+              "nearest": np.random.default_rng(5).integers(0, 256, (48, 48, 3), dtype=np.uint8)}
+    plane = ",".join(str(x) for x in (*OBLIQUE["origin"], *OBLIQUE["u"], *OBLIQUE["v"]))
+    for expected, image in images.items():
+        ex = upload_ready(c, image)
+        vid = c.create_volume(exemplar=ex["id"], seed=3)["id"]
+        body = {**{k: list(v) for k, v in OBLIQUE.items()}}
+        auto = requests.post(f"{shared.server.url}/v1/volumes/{vid}/cut", json=body, headers=RAW, timeout=120)
+        assert auto.status_code == 200 and auto.headers["X-Resample"] == expected, (auto.status_code, auto.headers)
+        explicit = requests.post(f"{shared.server.url}/v1/volumes/{vid}/cut", json={**body, "resample": expected},
+                                 headers=RAW, timeout=120)
+        other = requests.post(f"{shared.server.url}/v1/volumes/{vid}/cut",
+                              json={**body, "resample": "nearest" if expected == "cubic" else "cubic"}, headers=RAW, timeout=120)
+        assert explicit.content == auto.content and other.content != auto.content
+        table = tmp_path / f"{expected}.stx"
+        table.write_bytes(c.get_exemplar_table(ex["id"]))
+        out, stats = tmp_path / f"{expected}.png", tmp_path / f"{expected}.json"
+        run_cli("slice", table, "--plane", plane, "--size", "32,24", "--seed", "3", "-o", out, "--stats", stats)
+        assert json.loads(stats.read_text())["resample"] == expected
+        assert np.array_equal(file_pixels(out), np.frombuffer(auto.content, np.uint8).reshape(24, 32, 3))
 
 
 def test_scale_slice_and_cut_are_the_raw_routes_bytes(shared):

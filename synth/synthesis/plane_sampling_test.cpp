@@ -1,0 +1,128 @@
+#include "synthesis/plane_sampling.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+
+#include "analysis/analysis.h"
+#include "core/hash.h"
+#include "core/image_io.h"
+#include "synthesis/target.h"
+#include "testkit/test_support.h"
+
+namespace solidtex {
+namespace {
+
+// Gray image, value(x, y) in [0, 1] given as sRGB, stored linear like every exemplar.
+template <class F>
+ImageF gray(int w, int h, F value) {
+  ImageF im(w, h, 3);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < 3; ++c) im.at(x, y)[c] = srgb_to_linear(float(value(x, y)));
+  return im;
+}
+
+ImageF white_noise(int w, int h) {
+  return gray(w, h, [](int x, int y) { return double(hash_unit(hash_u64(uint64_t(x), uint64_t(y), 7))); });
+}
+
+ImageF wave(int w, int h) {
+  return gray(w, h, [](int x, int y) { return 0.5 + 0.3 * std::sin(2 * M_PI * x / 32.0) * std::cos(2 * M_PI * y / 32.0); });
+}
+
+TEST(PlaneSampling, ParsesItsThreeNamesAndNamesTheFieldOtherwise) {
+  EXPECT_FALSE(parse_plane_sampling("auto", "resample").value().has_value());
+  EXPECT_EQ(parse_plane_sampling("nearest", "resample").value(), PlaneSampling::kNearest);
+  EXPECT_EQ(parse_plane_sampling("cubic", "resample").value(), PlaneSampling::kCubic);
+  for (const char* bad : {"", "Cubic", "bilinear", "lanczos"}) {
+    const auto r = parse_plane_sampling(bad, "--resample");
+    ASSERT_FALSE(r) << bad;
+    EXPECT_EQ(r.status().field(), "--resample");
+  }
+  EXPECT_STREQ(plane_sampling_name(PlaneSampling::kCubic), "cubic");
+  EXPECT_STREQ(plane_sampling_name(PlaneSampling::kNearest), "nearest");
+}
+
+TEST(PlaneSampling, FineDetailShareSeparatesPixelDetailFromBlobs) {
+  // A one-pixel checkerboard is all band 0: its 2 x 2 means are flat.
+  EXPECT_NEAR(fine_detail_share(gray(32, 32, [](int x, int y) { return (x + y) % 2 ? 0.8 : 0.2; })), 1.0, 1e-9);
+  // 8-pixel squares are all band 1 and coarser: every 2 x 2 block is flat, and so is band 0.
+  EXPECT_NEAR(fine_detail_share(gray(32, 32, [](int x, int y) { return (x / 8 + y / 8) % 2 ? 0.8 : 0.2; })), 0.0,
+              1e-9);
+  // 2-pixel stripes put their contrast one octave up: band 1 only.
+  EXPECT_NEAR(fine_detail_share(gray(32, 32, [](int x, int) { return (x / 2) % 2 ? 0.8 : 0.2; })), 0.0, 1e-9);
+  // Per-pixel white noise: band 0 holds 3/4 of its variance, band 1 3/16, so 0.8.
+  EXPECT_NEAR(fine_detail_share(white_noise(128, 128)), 0.8, 0.03);
+  // Smooth ramps: deviations from 2 x 2 means are half those from 4 x 4 means, so about 0.2.
+  EXPECT_NEAR(fine_detail_share(wave(64, 64)), 0.2, 0.02);
+  // No detail, or too small for two bands: 0.
+  EXPECT_EQ(fine_detail_share(gray(32, 32, [](int, int) { return 0.4; })), 0.0);
+  EXPECT_EQ(fine_detail_share(gray(3, 3, [](int x, int) { return x % 2 ? 1.0 : 0.0; })), 0.0);
+}
+
+std::shared_ptr<const Table> small_table(const ImageF& image) {
+  ExemplarInputs in;
+  in.xy = image;
+  AnalysisParams p;
+  p.levels = 2;
+  p.neighborhood = 5;
+  p.candidates = 4;
+  p.pca_dims = 6;
+  return analyze(ExemplarSet::create(std::move(in)).value(), p).value().table;
+}
+
+TEST(PlaneSampling, TablesPreferCubicOnlyWithoutPixelDetailAndRegionsOnlyWhenAllDo) {
+  const auto blobs = small_table(wave(32, 32));
+  const auto speckle = small_table(white_noise(32, 32));
+  EXPECT_LT(fine_detail_share(*blobs), kCubicMaxFineDetailShare);
+  EXPECT_GE(fine_detail_share(*speckle), kCubicMaxFineDetailShare);
+  EXPECT_EQ(preferred_plane_sampling(*blobs), PlaneSampling::kCubic);
+  EXPECT_EQ(preferred_plane_sampling(*speckle), PlaneSampling::kNearest);
+  EXPECT_EQ(preferred_plane_sampling(std::vector<const Table*>{blobs.get()}), PlaneSampling::kCubic);
+  EXPECT_EQ(preferred_plane_sampling(std::vector<const Table*>{blobs.get(), speckle.get()}), PlaneSampling::kNearest);
+  EXPECT_EQ(preferred_plane_sampling(std::vector<const Table*>{}), PlaneSampling::kNearest);
+}
+
+TEST(PlaneSampling, AutoTakesThePreferredSamplingAndNeverRefusesWhatNearestTakes) {
+  const WorldPoint o{0.5, 2, 3}, u{0.6, 0.8, 0}, v{-0.48, 0.36, 0.8};
+  EXPECT_EQ(TargetSet::plane_cut(o, u, v, 16, 16, std::nullopt, PlaneSampling::kCubic).value().sampling(),
+            PlaneSampling::kCubic);
+  EXPECT_EQ(TargetSet::plane_cut(o, u, v, 16, 16, std::nullopt, PlaneSampling::kNearest).value().sampling(),
+            PlaneSampling::kNearest);
+  EXPECT_EQ(TargetSet::plane_cut(o, u, v, 16, 16, PlaneSampling::kNearest, PlaneSampling::kCubic).value().sampling(),
+            PlaneSampling::kNearest);
+  // Past the cubic bounds (kMaxResampledSamples pixels): cubic is refused, auto samples nearest.
+  const int w = 2048, h = int(kMaxResampledSamples / w) + 1;
+  const auto refused = TargetSet::plane_cut(o, u, v, w, h, PlaneSampling::kCubic, PlaneSampling::kCubic);
+  ASSERT_FALSE(refused);
+  EXPECT_EQ(refused.status().code(), StatusCode::kTooLarge);
+  const auto fallback = TargetSet::plane_cut(o, u, v, w, h, std::nullopt, PlaneSampling::kCubic);
+  ASSERT_TRUE(fallback) << fallback.status().message();
+  EXPECT_EQ(fallback.value().sampling(), PlaneSampling::kNearest);
+  // Other errors are not hidden by the fallback.
+  EXPECT_EQ(TargetSet::plane_cut({NAN, 0, 0}, u, v, 16, 16, std::nullopt, PlaneSampling::kCubic).status().field(),
+            "origin");
+}
+
+// The measurement the threshold rests on (README, Quality, "Oblique cuts"): cubic resampling
+// made the oblique 256^2 cut better on these five shared exemplars and worse on the other five.
+// Their shares, by texmetric's pyramid over their 8-bit sRGB pixels: 0.27-0.40 and 0.46-0.68.
+TEST(PlaneSampling, SharedExemplarsSplitAsMeasured) {
+  if (testing::exemplar_path("pebbles.png").empty())
+    GTEST_SKIP() << "../shared/data/exemplars is absent: real-exemplar test skipped";
+  const std::map<std::string, bool> cubic_was_better = {
+      {"gravel", true},  {"leopard", true},    {"pebbles", true},      {"stripes_dunes", true}, {"wood_planks", true},
+      {"bricks", false}, {"marble_pink", false}, {"tree_bark", false}, {"weave_burlap", false}, {"wood_grain", false}};
+  for (const auto& [name, better] : cubic_was_better) {
+    const std::string path = testing::exemplar_path(name + ".png");
+    ASSERT_FALSE(path.empty()) << name;
+    const double share = fine_detail_share(load_image(path).value());
+    EXPECT_EQ(share < kCubicMaxFineDetailShare, better) << name << ": share " << share;
+    EXPECT_GT(std::abs(share - kCubicMaxFineDetailShare), 0.02) << name << " sits on the threshold: " << share;
+  }
+}
+
+}  // namespace
+}  // namespace solidtex
