@@ -1,6 +1,7 @@
 // solidtex slice TABLE.stx (--axis x|y|z --at K --origin U,V | --plane OX,OY,OZ,UX,UY,UZ,VX,VY,VZ [--resample auto|nearest|cubic])
 //   --size W,H [--scheme plain|subpass|grid|dual-grid] [--field identity|quat:W,X,Y,Z|axis:..|FILE]
 //   [--seed S] [--threads T] [--passes P] [--coarse-passes P] [--cell M] -o OUT.png [--stats STATS.json]
+//   [--reference REF.png] (axis cuts: the exemplar of the cut's plane, oriented as the cut)
 #include <nlohmann/json.hpp>
 
 #include <fstream>
@@ -85,16 +86,31 @@ Result<TargetSet> build_cut(const CutArgs& c, PlaneSampling preferred) {
                               preferred);
 }
 
+// The exemplar an axis cut's plane was synthesized from, in the cut's pixel orientation:
+// axis z shows plane xy (x right, y down), axis x plane yz (y right, z down), and axis y plane
+// zx with its axes swapped (x right, z down; zx's first axis is z). So a cut along a y grain
+// shows the grain the way its plane's image (E transposed) runs, and should be judged against it.
+ImageF axis_cut_exemplar(const Table& table, char axis) {
+  const Plane plane = axis == 'z' ? Plane::kXY : axis == 'x' ? Plane::kYZ : Plane::kZX;
+  const ImageF& image = table.exemplars().plane(plane);
+  ImageF rgb(image.width, image.height, 3);
+  for (int64_t i = 0; i < image.pixel_count(); ++i)
+    for (int c = 0; c < 3; ++c) rgb.pixels[size_t(i) * 3 + size_t(c)] = image.pixels[size_t(i) * image.channels + size_t(c)];
+  return axis == 'y' ? transposed(rgb) : rgb;
+}
+
 Status run_slice(const std::vector<std::string>& argv) {
   Args args({"-o", "--axis", "--at", "--origin", "--plane", "--resample", "--size", "--scheme", "--field", "--seed", "--threads",
              "--stats", "--passes", "--coarse-passes", "--cell", "--cache-mb", "--plane-weights", "--matcher", "--region-table", "--regions",
-             "--typicality", "--balance", "--init", "--color", "--finest-subpass-size"},
+             "--typicality", "--balance", "--init", "--color", "--finest-subpass-size", "--reference"},
             {"--energy"});
   SOLIDTEX_RETURN_IF_ERROR(args.parse(argv));
   if (args.positionals().size() != 1)
     return Status(StatusCode::kInvalidArgument, "expects exactly one TABLE.stx", "table");
   SOLIDTEX_ASSIGN_OR_RETURN(std::string out, args.required("-o"));
   SOLIDTEX_ASSIGN_OR_RETURN(const CutArgs cut, parse_cut(args));
+  if (cut.plane && args.has("--reference"))
+    return Status(StatusCode::kInvalidArgument, "applies to axis cuts only", "--reference");
   SynthesisParams params;
   if (auto s = args.get("--scheme")) {
     SOLIDTEX_ASSIGN_OR_RETURN(params.scheme, parse_scheme(*s));
@@ -175,6 +191,9 @@ Status run_slice(const std::vector<std::string>& argv) {
     // Neighborhood-matching energy of the cut against exemplar xy (quality.h).
     j["energy"] = neighborhood_energy(img, table->exemplars().plane(Plane::kXY), table->params().neighborhood, 2);
     std::cerr << "energy " << j["energy"] << "\n";
+  }
+  if (auto path = args.get("--reference")) {
+    SOLIDTEX_RETURN_IF_ERROR(save_png_srgb8(*path, axis_cut_exemplar(*table, cut.axis)));
   }
   if (auto path = args.get("--stats")) {
     const std::string text = j.dump(2) + "\n";

@@ -33,7 +33,7 @@ constexpr const char* kUsage =
     "          [--resample auto|nearest|cubic])\n"
     "          --size W,H [--scheme plain|subpass|grid|dual-grid] [--field identity|quat:W,X,Y,Z|FILE]\n"
     "          [--seed S] [--threads T] [--typicality 0.5] [--balance 1] [--init auto|scatter|slab] [--color medoid|mean]\n"
-    "          [--finest-subpass-size 1|2] [--stats STATS.json] -o OUT.png\n"
+    "          [--finest-subpass-size 1|2] [--stats STATS.json] [--reference REF.png] -o OUT.png\n"
     "  field SKETCH.json -o FIELD.stf [--json]\n"
     "  serve [--host 127.0.0.1] [--port 8080] [--data DIR] [--threads N] [--queue N] [--deadline S]\n"
     "          [--cache-mb M] [--max-upload-mb M] [--max-image-side PX] [--max-voxels N] [--max-jobs N]\n"

@@ -346,3 +346,24 @@ def test_synthesized_answers_are_immutable_and_revalidate(shared):
                         timeout=60)
     assert cut.status_code == 200 and cut.headers["Cache-Control"].endswith("immutable")
     assert cut.headers["ETag"] == etag  # the same voxels, the same PNG bytes
+
+
+def test_cli_reference_is_the_exemplar_as_each_axis_cut_shows_its_plane(tmp_path):
+    """`slice --reference` writes the exemplar an axis cut's plane was synthesized from, in the
+    cut's pixel orientation (what bench/bench_quality.py scores axis cuts against): with
+    `--grain y` plane xy holds E, yz holds E transposed and zx (end grain) E, so the z cut shows
+    E, the x cut E transposed, and the y cut (x across, z down: zx transposed) E transposed."""
+    from PIL import Image
+    rng = np.random.default_rng(3)
+    exemplar = rng.integers(0, 256, (16, 24, 3), dtype=np.uint8)  # 24 wide, 16 high: transposes show
+    src = tmp_path / "e.png"
+    Image.fromarray(exemplar).save(src)
+    table = tmp_path / "e.stx"
+    run_cli("analyze", src, "--grain", "y", "--levels", "2", "--neighborhood", "5", "--candidates", "4",
+            "--pca-dims", "6", "--balance-rounds", "0", "-o", table)
+    expected = {"z": exemplar, "x": exemplar.transpose(1, 0, 2), "y": exemplar.transpose(1, 0, 2)}
+    for axis, want in expected.items():
+        ref = tmp_path / f"ref_{axis}.png"
+        run_cli("slice", table, "--axis", axis, "--at", "0", "--size", "4,4", "-o", tmp_path / f"{axis}.png",
+                "--reference", ref)
+        assert np.array_equal(file_pixels(ref), want), axis
