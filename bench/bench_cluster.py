@@ -13,7 +13,7 @@
    every 1/RATE s whatever the answers; latency counted from when it was due, so queueing
    shows): p50/p99/max ms.
 2. A random walk of neighbouring cuts (--cut-size, 64² slices by default; 256² is what the
-   browser app asks for: `at` +-1..2, panning +-16 voxels, one in
+   browser app asks for: `at` +-1, panning +-16 voxels, one in
    five steps back to a cut seen before) through 3 replicas, with consistent hashing and with
    round-robin, on cold replicas: nginx's hit rate (X-Cache-Status) and the replicas' voxel-
    cache hit rate (voxel lookups found / made, summed from each replica's
