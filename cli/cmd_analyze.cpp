@@ -17,7 +17,7 @@
 #include "commands.h"
 #include "core/image_io.h"
 #include "progress_bar.h"
-#include "synthesis/plane_sampling.h"
+#include "synthesis/voxel_sampling.h"
 #include "synthesis/usage_balance.h"
 #include "analysis/table_file.h"
 
@@ -100,9 +100,9 @@ Status run_analyze(const std::vector<std::string>& argv) {
     j["shared_exemplar"] = exemplars.shared();
     j["grain"] = *layout;
     j["channels"] = exemplars.channels();
-    // What its oblique cuts' resample auto will be (synthesis/plane_sampling.h).
+    // What its oblique cuts' resample auto will be (synthesis/voxel_sampling.h).
     j["fine_detail_share"] = fine_detail_share(*result.table);
-    j["cut_resample"] = plane_sampling_name(preferred_plane_sampling(*result.table));
+    j["cut_resample"] = voxel_sampling_name(preferred_voxel_sampling(*result.table));
     nlohmann::json levels = nlohmann::json::array();
     for (const LevelReport& r : result.levels)
       levels.push_back({{"level", r.level},

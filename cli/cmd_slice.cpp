@@ -39,12 +39,12 @@ nlohmann::json stats_json(const SynthesisStats& s) {
 }
 
 // The cut the options name, checked before any table loads; built once the tables are known
-// (--resample auto, the default, takes their preferred_plane_sampling).
+// (--resample auto, the default, takes their preferred_voxel_sampling).
 struct CutArgs {
   int width = 0, height = 0;
   bool plane = false;
   std::vector<double> plane_vectors;      // --plane: origin, u, v
-  std::optional<PlaneSampling> resample;  // --plane only; nullopt: auto
+  std::optional<VoxelSampling> resample;  // --plane only; nullopt: auto
   char axis = 'z';
   int at = 0;
   std::vector<double> origin{0, 0};
@@ -63,7 +63,7 @@ Result<CutArgs> parse_cut(const Args& args) {
     SOLIDTEX_ASSIGN_OR_RETURN(c.plane_vectors, args.get_list("--plane", 9));
     if (args.has("--resample")) {
       SOLIDTEX_ASSIGN_OR_RETURN(std::string name, args.required("--resample"));
-      SOLIDTEX_ASSIGN_OR_RETURN(c.resample, parse_plane_sampling(name, "--resample"));
+      SOLIDTEX_ASSIGN_OR_RETURN(c.resample, parse_voxel_sampling(name, "--resample"));
     }
     return c;
   }
@@ -79,7 +79,7 @@ Result<CutArgs> parse_cut(const Args& args) {
 }
 
 // `preferred`: the sampling auto stands for.
-Result<TargetSet> build_cut(const CutArgs& c, PlaneSampling preferred) {
+Result<TargetSet> build_cut(const CutArgs& c, VoxelSampling preferred) {
   if (!c.plane) return TargetSet::axis_cut(c.axis, c.at, int(c.origin[0]), int(c.origin[1]), c.width, c.height);
   const auto& p = c.plane_vectors;
   return TargetSet::plane_cut({p[0], p[1], p[2]}, {p[3], p[4], p[5]}, {p[6], p[7], p[8]}, c.width, c.height, c.resample,
@@ -155,7 +155,7 @@ Status run_slice(const std::vector<std::string>& argv) {
   }
   std::vector<const Table*> cut_tables;
   for (const auto& t : tables) cut_tables.push_back(t.get());
-  const PlaneSampling preferred = preferred_plane_sampling(cut_tables);
+  const VoxelSampling preferred = preferred_voxel_sampling(cut_tables);
   SOLIDTEX_ASSIGN_OR_RETURN(const TargetSet target, build_cut(cut, preferred));
   ProgressBar bar;
   SynthesisStats stats;
@@ -186,7 +186,7 @@ Status run_slice(const std::vector<std::string>& argv) {
   j["scheme"] = scheme_name(params.scheme);
   j["matcher"] = matcher_name(params.matcher);
   j["field"] = field->describe();
-  if (cut.plane) j["resample"] = plane_sampling_name(target.sampling());
+  if (cut.plane) j["resample"] = voxel_sampling_name(target.sampling());
   if (args.has("--energy")) {
     // Neighborhood-matching energy of the cut against exemplar xy (quality.h).
     j["energy"] = neighborhood_energy(img, table->exemplars().plane(Plane::kXY), table->params().neighborhood, 2);

@@ -495,6 +495,11 @@ HttpResponse Api::slice(const HttpRequest& r) {
   return result ? *result : HttpResponse::error(result.status());
 }
 
+Result<VoxelSampling> Api::auto_sampling(const HttpRequest& r, const std::optional<VoxelSampling>& requested) {
+  if (requested) return *requested;  // auto only needs the volume's tables
+  return volumes_.preferred_voxel_sampling(r.param("id"));
+}
+
 HttpResponse Api::cut(const HttpRequest& r) {
   auto result = [&]() -> Result<HttpResponse> {
     SOLIDTEX_ASSIGN_OR_RETURN(QueryParams q, QueryParams::parse(r.query, {"scale", "timeout"}));
@@ -512,19 +517,16 @@ HttpResponse Api::cut(const HttpRequest& r) {
     SOLIDTEX_ASSIGN_OR_RETURN(int64_t h, json_int(j["size"][1], "size", 1, kMaxCutSide));
     SOLIDTEX_RETURN_IF_ERROR(volumes_.check_target_size(w * h, "size"));
     SOLIDTEX_ASSIGN_OR_RETURN(const int level, level_of_scale(r, q));
-    std::optional<PlaneSampling> requested;  // auto
+    std::optional<VoxelSampling> requested;  // auto
     if (j.contains("resample")) {
       if (!j["resample"].is_string())
         return Status(StatusCode::kInvalidArgument, "must be auto, nearest or cubic", "resample");
-      SOLIDTEX_ASSIGN_OR_RETURN(requested, parse_plane_sampling(j["resample"].get<std::string>(), "resample"));
+      SOLIDTEX_ASSIGN_OR_RETURN(requested, parse_voxel_sampling(j["resample"].get<std::string>(), "resample"));
     }
-    PlaneSampling preferred = PlaneSampling::kNearest;
-    if (!requested) {
-      SOLIDTEX_ASSIGN_OR_RETURN(preferred, volumes_.preferred_plane_sampling(r.param("id")));
-    }
+    SOLIDTEX_ASSIGN_OR_RETURN(const VoxelSampling preferred, auto_sampling(r, requested));
     SOLIDTEX_ASSIGN_OR_RETURN(TargetSet target, TargetSet::plane_cut(origin, u, v, int(w), int(h), requested, preferred));
     SOLIDTEX_ASSIGN_OR_RETURN(HttpResponse out, synthesize_image(r, "cut", target, q.get("timeout"), level));
-    out.headers.push_back({"X-Resample", plane_sampling_name(target.sampling())});
+    out.headers.push_back({"X-Resample", voxel_sampling_name(target.sampling())});
     return out;
   }();
   return result ? *result : HttpResponse::error(result.status());
@@ -561,7 +563,13 @@ HttpResponse Api::region(const HttpRequest& r) {
 
 HttpResponse Api::points(const HttpRequest& r) {
   auto result = [&]() -> Result<HttpResponse> {
-    SOLIDTEX_ASSIGN_OR_RETURN(QueryParams q, QueryParams::parse(r.query, {"timeout"}));
+    SOLIDTEX_ASSIGN_OR_RETURN(QueryParams q, QueryParams::parse(r.query, {"timeout", "resample"}));
+    // Points sample their nearest voxels unless told: scattered points share no cubic taps, so
+    // resampling could read 64 voxels for each (dense ones, such as a bake's texels, share them).
+    std::optional<VoxelSampling> requested = VoxelSampling::kNearest;
+    if (auto name = q.get("resample")) {
+      SOLIDTEX_ASSIGN_OR_RETURN(requested, parse_voxel_sampling(*name, "resample"));
+    }
     std::vector<WorldPoint> pts;
     if (r.content_type == "application/json") {
       SOLIDTEX_ASSIGN_OR_RETURN(json j, parse_request_json(r.body, "body"));
@@ -594,13 +602,15 @@ HttpResponse Api::points(const HttpRequest& r) {
       return Status(StatusCode::kUnsupported, "expected application/octet-stream or application/json", "Content-Type");
     }
     if (pts.empty()) return Status(StatusCode::kInvalidArgument, "holds no points", "body");
-    SOLIDTEX_ASSIGN_OR_RETURN(TargetSet target, TargetSet::points(pts));
+    SOLIDTEX_ASSIGN_OR_RETURN(const VoxelSampling preferred, auto_sampling(r, requested));
+    SOLIDTEX_ASSIGN_OR_RETURN(TargetSet target, TargetSet::points(pts, requested, preferred));
     auto qr = query_volume(r, "points", target, q.get("timeout"));
     if (!qr) return qr.status();
     const Encoding enc = r.accept.find("application/json") != std::string::npos ? Encoding::kJson : Encoding::kFloat32;
     SOLIDTEX_ASSIGN_OR_RETURN(HttpResponse out,
                               encode_colors(qr->rgb, int(pts.size()), 1, std::to_string(pts.size()) + ",3", enc));
     out.headers.push_back({"X-Voxels-Synthesized", std::to_string(qr->voxels_synthesized)});
+    out.headers.push_back({"X-Resample", voxel_sampling_name(target.sampling())});
     mark_immutable(out);
     return conditional_get(r, std::move(out));
   }();

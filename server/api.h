@@ -107,6 +107,9 @@ class Api {
   // The `scale` query parameter of slice and cut (dataset s of the pyramid, as /zarr's): the
   // synthesis level to pass to query_volume (-1 for scale 0, the finest); 404 past the coarsest.
   Result<int> level_of_scale(const HttpRequest& r, const QueryParams& q);
+  // What `resample` auto (nullopt) stands for in volume r.param("id"): its preferred sampling;
+  // a given sampling is returned as is, without loading the volume.
+  Result<VoxelSampling> auto_sampling(const HttpRequest& r, const std::optional<VoxelSampling>& requested);
   HttpResponse array_metadata(const HttpRequest& r, const std::function<Result<nlohmann::json>(const ArrayView&)>& make);
   // Adds a content ETag and `Cache-Control: immutable` to a synthesized answer (200 only).
   static void mark_immutable(HttpResponse& out);

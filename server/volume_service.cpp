@@ -61,7 +61,7 @@ struct VolumeState {
   std::shared_ptr<const SurfaceDistance> surface;
   std::vector<std::shared_ptr<const Table>> tables;  // distinct; shared with other volumes of the exemplar
   std::vector<int64_t> table_bytes;                  // per entry of `tables`
-  PlaneSampling plane_sampling = PlaneSampling::kNearest;  // what plane cuts' resample "auto" stands for
+  VoxelSampling sampling = VoxelSampling::kNearest;  // what resample "auto" stands for in cuts and points
   int64_t synthesizer_bytes = 0, field_bytes = 0, surface_bytes = 0;
 
   int64_t own_bytes() const { return synthesizer_bytes + field_bytes + surface_bytes; }
@@ -294,7 +294,7 @@ struct VolumeService::Impl {
     }
     std::vector<const Table*> tables;
     for (const auto& t : st->tables) tables.push_back(t.get());
-    st->plane_sampling = solidtex::preferred_plane_sampling(tables);
+    st->sampling = solidtex::preferred_voxel_sampling(tables);
     st->field_bytes = field_resident_bytes(*st->field);
     st->surface_bytes = st->surface ? st->surface->resident_bytes() : 0;
     return st;
@@ -741,9 +741,9 @@ Result<VolumeService::ArrayInfo> VolumeService::array_info(const std::string& id
   return out;
 }
 
-Result<PlaneSampling> VolumeService::preferred_plane_sampling(const std::string& id) {
+Result<VoxelSampling> VolumeService::preferred_voxel_sampling(const std::string& id) {
   SOLIDTEX_ASSIGN_OR_RETURN(const Impl::Hold held, impl_->hold(id));
-  return held.state->plane_sampling;
+  return held.state->sampling;
 }
 
 Result<QueryResult> VolumeService::query(const std::string& id, const std::string& kind, const TargetSet& target,

@@ -79,9 +79,9 @@ class VolumeService {
     std::string tag;
   };
   Result<ArrayInfo> array_info(const std::string& id);
-  // What a plane cut's resample "auto" stands for: the volume's tables' preferred sampling
-  // (synthesis/plane_sampling.h), worked out once per loaded state.
-  Result<PlaneSampling> preferred_plane_sampling(const std::string& id);
+  // What resample "auto" stands for in this volume's plane cuts and points: its tables' preferred
+  // sampling (synthesis/voxel_sampling.h), worked out once per loaded state.
+  Result<VoxelSampling> preferred_voxel_sampling(const std::string& id);
   Status check_target_size(int64_t samples, const std::string& field) const;
   Result<nlohmann::json> stats(const std::string& id) const;
 

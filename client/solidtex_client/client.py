@@ -687,12 +687,18 @@ class Client:
         w, h, d = (int(s) for s in size)
         return _binary_answer(r, fmt, fallback=(d, h, w, 3))
 
-    def points(self, volume_id: str, xyz: Any, timeout: Optional[float] = None) -> np.ndarray:
+    def points(self, volume_id: str, xyz: Any, timeout: Optional[float] = None,
+               resample: Optional[str] = None) -> np.ndarray:
         """POST /v1/volumes/{id}/points: linear RGB float32 (N, 3) at world points ``xyz``
         (N, 3), each rounded to its nearest finest voxel (voxel (i, j, k) is at (i, j, k)).
+        ``resample``: ``None`` or ``"nearest"`` (that), ``"cubic"`` (the Catmull-Rom
+        resampling of the voxels around each point, as cuts resample; dense points share their
+        voxels, scattered ones read up to 64 each) or ``"auto"`` (what the volume's cuts use);
+        the answer's ``X-Resample`` header says which.
         """
         pts = _rows(xyz, 3)
         r = self._timed("POST", f"/v1/volumes/{volume_id}/points", timeout,
+                        params={"resample": resample},
                         data=pts.astype("<f4").tobytes(),
                         headers={"Content-Type": "application/octet-stream",
                                  "Accept": "application/octet-stream"})

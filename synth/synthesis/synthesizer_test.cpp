@@ -213,7 +213,7 @@ TEST_F(SynthesizerTest, PlaneCutsResampleTheVoxelsWithCatmullRom) {
   auto s = make(table_, "identity", small_params(), 0);
   const WorldPoint o{2.3, -1.6, 4.45}, u{0.6, 0.8, 0}, v{-0.48, 0.36, 0.8};
   const int w = 5, h = 4;
-  const auto got = s->synthesize(TargetSet::plane_cut(o, u, v, w, h, PlaneSampling::kCubic).value()).value();
+  const auto got = s->synthesize(TargetSet::plane_cut(o, u, v, w, h, VoxelSampling::kCubic).value()).value();
   ASSERT_EQ(got.size(), size_t(w * h));
   auto weights = [](double t) {  // Keys' cubic with a = -0.5 at distances 1 + t, t, 1 - t, 2 - t
     auto k = [](double x) {
@@ -248,7 +248,7 @@ TEST_F(SynthesizerTest, PlaneCutsResampleTheVoxelsWithCatmullRom) {
     }
   EXPECT_GT(differs_from_nearest, w * h / 2);  // it resamples, it does not just pick voxels
   // Along the axes cubic sampling is the axis cut, bit for bit; nearest picks voxels.
-  EXPECT_EQ(s->synthesize(TargetSet::plane_cut({-3, 7, 4}, {1, 0, 0}, {0, 0, 1}, 10, 6, PlaneSampling::kCubic).value()).value(),
+  EXPECT_EQ(s->synthesize(TargetSet::plane_cut({-3, 7, 4}, {1, 0, 0}, {0, 0, 1}, 10, 6, VoxelSampling::kCubic).value()).value(),
             cut(*s, 'y', 7, -3, 4, 10, 6));
   const auto nearest_cut = s->synthesize(TargetSet::plane_cut(o, u, v, w, h).value()).value();
   EXPECT_EQ(nearest_cut[0], s->synthesize(TargetSet::points({o}).value()).value()[0]);

@@ -89,29 +89,17 @@ Result<TargetSet> TargetSet::axis_cut(char axis, int at, int u0, int v0, int wid
   return from_voxels(s, width, height);
 }
 
-Result<TargetSet> TargetSet::plane_cut(const WorldPoint& o, const WorldPoint& u, const WorldPoint& v, int width, int height,
-                                       PlaneSampling sampling) {
-  SOLIDTEX_RETURN_IF_ERROR(check_size(width, height));
-  SOLIDTEX_RETURN_IF_ERROR(check_point(o, "origin"));
-  SOLIDTEX_RETURN_IF_ERROR(check_point(u, "u"));
-  SOLIDTEX_RETURN_IF_ERROR(check_point(v, "v"));
-  const WorldPoint far{o.x + u.x * width + v.x * height, o.y + u.y * width + v.y * height, o.z + u.z * width + v.z * height};
-  SOLIDTEX_RETURN_IF_ERROR(check_point(far, "size"));
-  if (sampling == PlaneSampling::kNearest) {
-    std::vector<Voxel> s;
-    s.reserve(size_t(width) * height);
-    for (int j = 0; j < height; ++j)
-      for (int i = 0; i < width; ++i)
-        s.push_back({int(std::lround(o.x + i * u.x + j * v.x)), int(std::lround(o.y + i * u.y + j * v.y)),
-                     int(std::lround(o.z + i * u.z + j * v.z))});
-    return from_voxels(s, width, height);
-  }
-  const size_t n = size_t(width) * height;
+namespace {
+
+// A cubic-resampled target: n samples, sample k at position(k) (voxel units), shaped width x
+// height. `unit` names the samples in errors ("pixels", "points"), which name `field`.
+template <class Position>
+Result<TargetSet> resampled(size_t n, int width, int height, Position&& position, const char* unit, const char* field) {
   if (int64_t(n) > kMaxResampledSamples)
     return Status(StatusCode::kTooLarge,
-                  "cubic resampling takes at most " + std::to_string(kMaxResampledSamples) +
-                      " pixels; use resample nearest or a smaller cut",
-                  "size");
+                  std::string("cubic resampling takes at most ") + std::to_string(kMaxResampledSamples) + " " + unit +
+                      "; use resample nearest, or fewer",
+                  field);
   TargetSet t;
   t.width = width;
   t.height = height;
@@ -120,8 +108,9 @@ Result<TargetSet> TargetSet::plane_cut(const WorldPoint& o, const WorldPoint& u,
   std::vector<Voxel> nearest(n), needed;
   // Neighbouring samples share most of their 4x4x4 taps: deduplicate as the list grows, so
   // memory stays near the distinct voxels (a slab ~5 voxels thick), not 64 per sample. Sparse
-  // cuts (steps of several voxels, lines) share nothing: past kMaxResampledVoxels distinct
-  // voxels the cut is refused before more memory is spent (transient <= 2x that + 1 Mi voxels).
+  // samples (cut steps of several voxels, lines, scattered points) share nothing: past
+  // kMaxResampledVoxels distinct voxels the target is refused before more memory is spent
+  // (transient <= 2x that + 1 Mi voxels).
   size_t distinct = 0;
   auto dedupe = [&] {  // needed[0, distinct) is sorted and distinct: sort the tail and merge
     const auto mid = needed.begin() + std::ptrdiff_t(distinct);
@@ -131,30 +120,28 @@ Result<TargetSet> TargetSet::plane_cut(const WorldPoint& o, const WorldPoint& u,
     needed.erase(std::unique(needed.begin(), needed.end()), needed.end());
     distinct = needed.size();
   };
-  auto too_many_voxels = [] {
+  auto too_many_voxels = [&] {
     return Status(StatusCode::kTooLarge,
-                  "cubic resampling of this cut needs more than " + std::to_string(kMaxResampledVoxels) +
-                      " voxels; use resample nearest, or a smaller cut with pixels closer together",
-                  "size");
+                  std::string("cubic resampling of these ") + unit + " needs more than " +
+                      std::to_string(kMaxResampledVoxels) + " voxels; use resample nearest, or fewer " + unit +
+                      " closer together",
+                  field);
   };
-  for (int j = 0; j < height; ++j) {
-    for (int i = 0; i < width; ++i) {
-      if (needed.size() > 2 * distinct + (size_t(1) << 20)) {
-        dedupe();
-        if (distinct > size_t(kMaxResampledVoxels)) return too_many_voxels();
-      }
-      const size_t k = size_t(j) * width + i;
-      const double p[3] = {o.x + i * u.x + j * v.x, o.y + i * u.y + j * v.y, o.z + i * u.z + j * v.z};
-      int fl[3];
-      for (int a = 0; a < 3; ++a) {
-        const double f = std::floor(p[a]);
-        fl[a] = int(f);
-        t.resample_t[k][size_t(a)] = float(p[a] - f);
-      }
-      t.resample_floor[k] = {fl[0], fl[1], fl[2]};
-      nearest[k] = {int(std::lround(p[0])), int(std::lround(p[1])), int(std::lround(p[2]))};
-      for_each_tap(t.resample_floor[k], t.resample_t[k], [&](const Voxel& q, float) { needed.push_back(q); });
+  for (size_t k = 0; k < n; ++k) {
+    if (needed.size() > 2 * distinct + (size_t(1) << 20)) {
+      dedupe();
+      if (distinct > size_t(kMaxResampledVoxels)) return too_many_voxels();
     }
+    const std::array<double, 3> p = position(k);
+    int fl[3];
+    for (int a = 0; a < 3; ++a) {
+      const double f = std::floor(p[size_t(a)]);
+      fl[a] = int(f);
+      t.resample_t[k][size_t(a)] = float(p[size_t(a)] - f);
+    }
+    t.resample_floor[k] = {fl[0], fl[1], fl[2]};
+    nearest[k] = {int(std::lround(p[0])), int(std::lround(p[1])), int(std::lround(p[2]))};
+    for_each_tap(t.resample_floor[k], t.resample_t[k], [&](const Voxel& q, float) { needed.push_back(q); });
   }
   dedupe();
   if (distinct > size_t(kMaxResampledVoxels)) return too_many_voxels();
@@ -165,14 +152,44 @@ Result<TargetSet> TargetSet::plane_cut(const WorldPoint& o, const WorldPoint& u,
   return t;
 }
 
-Result<TargetSet> TargetSet::plane_cut(const WorldPoint& o, const WorldPoint& u, const WorldPoint& v, int width, int height,
-                                       std::optional<PlaneSampling> resample, PlaneSampling preferred) {
-  if (resample) return plane_cut(o, u, v, width, height, *resample);
-  if (preferred == PlaneSampling::kCubic) {
-    auto cubic = plane_cut(o, u, v, width, height, PlaneSampling::kCubic);
+// `resample` as given; auto (nullopt): `preferred`, or nearest where cubic passes its bounds.
+template <class Build>
+Result<TargetSet> sample_as(std::optional<VoxelSampling> resample, VoxelSampling preferred, Build&& build) {
+  if (resample) return build(*resample);
+  if (preferred == VoxelSampling::kCubic) {
+    auto cubic = build(VoxelSampling::kCubic);
     if (cubic || cubic.status().code() != StatusCode::kTooLarge) return cubic;
   }
-  return plane_cut(o, u, v, width, height, PlaneSampling::kNearest);
+  return build(VoxelSampling::kNearest);
+}
+
+}  // namespace
+
+Result<TargetSet> TargetSet::plane_cut(const WorldPoint& o, const WorldPoint& u, const WorldPoint& v, int width, int height,
+                                       VoxelSampling sampling) {
+  SOLIDTEX_RETURN_IF_ERROR(check_size(width, height));
+  SOLIDTEX_RETURN_IF_ERROR(check_point(o, "origin"));
+  SOLIDTEX_RETURN_IF_ERROR(check_point(u, "u"));
+  SOLIDTEX_RETURN_IF_ERROR(check_point(v, "v"));
+  const WorldPoint far{o.x + u.x * width + v.x * height, o.y + u.y * width + v.y * height, o.z + u.z * width + v.z * height};
+  SOLIDTEX_RETURN_IF_ERROR(check_point(far, "size"));
+  auto position = [&](size_t k) {
+    const int i = int(k % size_t(width)), j = int(k / size_t(width));
+    return std::array<double, 3>{o.x + i * u.x + j * v.x, o.y + i * u.y + j * v.y, o.z + i * u.z + j * v.z};
+  };
+  const size_t n = size_t(width) * height;
+  if (sampling == VoxelSampling::kCubic) return resampled(n, width, height, position, "pixels", "size");
+  std::vector<Voxel> s(n);
+  for (size_t k = 0; k < n; ++k) {
+    const auto p = position(k);
+    s[k] = {int(std::lround(p[0])), int(std::lround(p[1])), int(std::lround(p[2]))};
+  }
+  return from_voxels(s, width, height);
+}
+
+Result<TargetSet> TargetSet::plane_cut(const WorldPoint& o, const WorldPoint& u, const WorldPoint& v, int width, int height,
+                                       std::optional<VoxelSampling> resample, VoxelSampling preferred) {
+  return sample_as(resample, preferred, [&](VoxelSampling s) { return plane_cut(o, u, v, width, height, s); });
 }
 
 std::vector<std::array<float, 3>> TargetSet::resolve(const std::vector<std::array<float, 3>>& voxel_rgb) const {
@@ -210,16 +227,21 @@ Result<TargetSet> TargetSet::box(const Voxel& min, int sx, int sy, int sz) {
   return from_voxels(s, sx, sy * sz);
 }
 
-Result<TargetSet> TargetSet::points(const std::vector<WorldPoint>& pts) {
+Result<TargetSet> TargetSet::points(const std::vector<WorldPoint>& pts, VoxelSampling sampling) {
   if (pts.empty()) return Status(StatusCode::kInvalidArgument, "no points given", "points");
   if (int64_t(pts.size()) > kMaxTargetSamples) return Status(StatusCode::kTooLarge, "too many points", "points");
+  for (const WorldPoint& p : pts) SOLIDTEX_RETURN_IF_ERROR(check_point(p, "points"));
+  auto position = [&](size_t k) { return std::array<double, 3>{pts[k].x, pts[k].y, pts[k].z}; };
+  if (sampling == VoxelSampling::kCubic) return resampled(pts.size(), int(pts.size()), 1, position, "points", "points");
   std::vector<Voxel> s;
   s.reserve(pts.size());
-  for (const WorldPoint& p : pts) {
-    SOLIDTEX_RETURN_IF_ERROR(check_point(p, "points"));
-    s.push_back({int(std::lround(p.x)), int(std::lround(p.y)), int(std::lround(p.z))});
-  }
+  for (const WorldPoint& p : pts) s.push_back({int(std::lround(p.x)), int(std::lround(p.y)), int(std::lround(p.z))});
   return from_voxels(s, int(pts.size()), 1);
+}
+
+Result<TargetSet> TargetSet::points(const std::vector<WorldPoint>& pts, std::optional<VoxelSampling> resample,
+                                    VoxelSampling preferred) {
+  return sample_as(resample, preferred, [&](VoxelSampling s) { return points(pts, s); });
 }
 
 }  // namespace solidtex

@@ -167,7 +167,7 @@ def test_cut_matches_cli_plane_and_slice(shared, tmp_path):
 
 def test_auto_resample_follows_the_exemplars_pixel_detail(shared, tmp_path):
     """`resample` auto, the default, is cubic for an exemplar whose contrast lies above the
-    pixel scale (a smooth wave) and nearest for per-pixel speckle (plane_sampling.h); the answer
+    pixel scale (a smooth wave) and nearest for per-pixel speckle (voxel_sampling.h); the answer
     says which in X-Resample, equals the explicit choice bit for bit, and the CLI's --plane
     (also auto by default) agrees and reports it in --stats."""
     c = shared.client
@@ -367,3 +367,23 @@ def test_cli_reference_is_the_exemplar_as_each_axis_cut_shows_its_plane(tmp_path
         run_cli("slice", table, "--axis", axis, "--at", "0", "--size", "4,4", "-o", tmp_path / f"{axis}.png",
                 "--reference", ref)
         assert np.array_equal(file_pixels(ref), want), axis
+
+
+def test_points_resample_like_plane_cuts(shared):
+    """/points samples nearest voxels unless `resample` says cubic or auto; points along a plane
+    give exactly that plane cut's pixels either way (float32), and X-Resample says which."""
+    c, vid = shared.client, shared.volume_id
+    plane = dict(origin=(1.25, 2.5, 3), u=(0.5, 0.75, 0), v=(-0.25, 0.5, 0.75), size=(20, 12))  # exact in float32
+    o, u, v = (np.array(plane[k], np.float64) for k in ("origin", "u", "v"))
+    w, h = plane["size"]
+    jj, ii = np.mgrid[0:h, 0:w]
+    pts = o + ii.reshape(-1, 1) * u + jj.reshape(-1, 1) * v
+    assert np.array_equal(pts.astype(np.float32).astype(np.float64), pts), "positions must survive float32"
+    for resample, sampled in ((None, "nearest"), ("nearest", "nearest"), ("cubic", "cubic"), ("auto", "cubic")):
+        rgb = c.points(vid, pts, resample=resample)
+        assert c.last_response.headers["X-Resample"] == sampled, (resample, c.last_response.headers)
+        cut = c.cut(vid, dtype="float32", resample=sampled, **plane)
+        assert np.array_equal(rgb.reshape(h, w, 3), cut), resample
+    r = requests.post(f"{shared.server.url}/v1/volumes/{vid}/points", params={"resample": "trilinear"},
+                      data=pts.astype("<f4").tobytes(), headers={"Content-Type": "application/octet-stream"}, timeout=60)
+    assert_error(r, 400, "invalid_argument", "resample")

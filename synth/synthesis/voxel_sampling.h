@@ -1,6 +1,6 @@
-// How a plane cut samples the finest voxels, and which sampling suits an exemplar.
+// How plane cuts and points sample the finest voxels, and which sampling suits an exemplar.
 //
-// Nearest voxels skip and repeat along a tilted plane: jaggies, which on smooth, blob-like
+// Nearest voxels skip and repeat along a tilted plane or surface: jaggies, which on smooth, blob-like
 // exemplars cost more than anything (rotating a z cut by 37 degrees that way raised its swd
 // 40-48 %, bicubically 1-4 %). Catmull-Rom resampling (target.h) removes them but attenuates
 // 1-voxel detail, and a solid's cuts carry that detail where the exemplar does. Which costs
@@ -23,15 +23,15 @@ namespace solidtex {
 class Table;
 struct ImageF;
 
-enum class PlaneSampling {
-  kNearest,  // the voxel nearest each pixel's position
+enum class VoxelSampling {
+  kNearest,  // the voxel nearest each sample's position
   kCubic,    // Catmull-Rom resampling of the 4x4x4 voxels around it (target.h)
 };
 
-// "nearest" | "cubic" | "auto"; nullopt is auto: preferred_plane_sampling of the cut's
+// "nearest" | "cubic" | "auto"; nullopt is auto: preferred_voxel_sampling of the volume's
 // exemplar(s). Errors name `field`.
-Result<std::optional<PlaneSampling>> parse_plane_sampling(const std::string& name, const std::string& field);
-const char* plane_sampling_name(PlaneSampling s);
+Result<std::optional<VoxelSampling>> parse_voxel_sampling(const std::string& name, const std::string& field);
+const char* voxel_sampling_name(VoxelSampling s);
 
 // e0 / (e0 + e1), where e_k is the mean square of band k of the image's Laplacian pyramid
 // (2 x 2 box means, pixel-repeated upsampling, as ../shared/tools/texmetric.py builds it) over
@@ -44,9 +44,9 @@ double fine_detail_share(const Table& table);
 
 inline constexpr double kCubicMaxFineDetailShare = 0.43;
 // kCubic when fine_detail_share(table) < kCubicMaxFineDetailShare, else kNearest.
-PlaneSampling preferred_plane_sampling(const Table& table);
-// Of a cut through several tables (a region volume): kCubic only when every table prefers it,
+VoxelSampling preferred_voxel_sampling(const Table& table);
+// Of a volume of several tables (a region volume): kCubic only when every table prefers it,
 // so that an exemplar with 1-voxel detail keeps it.
-PlaneSampling preferred_plane_sampling(const std::vector<const Table*>& tables);
+VoxelSampling preferred_voxel_sampling(const std::vector<const Table*>& tables);
 
 }  // namespace solidtex

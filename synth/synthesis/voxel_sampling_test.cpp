@@ -1,4 +1,4 @@
-#include "synthesis/plane_sampling.h"
+#include "synthesis/voxel_sampling.h"
 
 #include <gtest/gtest.h>
 
@@ -32,20 +32,20 @@ ImageF wave(int w, int h) {
   return gray(w, h, [](int x, int y) { return 0.5 + 0.3 * std::sin(2 * M_PI * x / 32.0) * std::cos(2 * M_PI * y / 32.0); });
 }
 
-TEST(PlaneSampling, ParsesItsThreeNamesAndNamesTheFieldOtherwise) {
-  EXPECT_FALSE(parse_plane_sampling("auto", "resample").value().has_value());
-  EXPECT_EQ(parse_plane_sampling("nearest", "resample").value(), PlaneSampling::kNearest);
-  EXPECT_EQ(parse_plane_sampling("cubic", "resample").value(), PlaneSampling::kCubic);
+TEST(VoxelSampling, ParsesItsThreeNamesAndNamesTheFieldOtherwise) {
+  EXPECT_FALSE(parse_voxel_sampling("auto", "resample").value().has_value());
+  EXPECT_EQ(parse_voxel_sampling("nearest", "resample").value(), VoxelSampling::kNearest);
+  EXPECT_EQ(parse_voxel_sampling("cubic", "resample").value(), VoxelSampling::kCubic);
   for (const char* bad : {"", "Cubic", "bilinear", "lanczos"}) {
-    const auto r = parse_plane_sampling(bad, "--resample");
+    const auto r = parse_voxel_sampling(bad, "--resample");
     ASSERT_FALSE(r) << bad;
     EXPECT_EQ(r.status().field(), "--resample");
   }
-  EXPECT_STREQ(plane_sampling_name(PlaneSampling::kCubic), "cubic");
-  EXPECT_STREQ(plane_sampling_name(PlaneSampling::kNearest), "nearest");
+  EXPECT_STREQ(voxel_sampling_name(VoxelSampling::kCubic), "cubic");
+  EXPECT_STREQ(voxel_sampling_name(VoxelSampling::kNearest), "nearest");
 }
 
-TEST(PlaneSampling, FineDetailShareSeparatesPixelDetailFromBlobs) {
+TEST(VoxelSampling, FineDetailShareSeparatesPixelDetailFromBlobs) {
   // A one-pixel checkerboard is all band 0: its 2 x 2 means are flat.
   EXPECT_NEAR(fine_detail_share(gray(32, 32, [](int x, int y) { return (x + y) % 2 ? 0.8 : 0.2; })), 1.0, 1e-9);
   // 8-pixel squares are all band 1 and coarser: every 2 x 2 block is flat, and so is band 0.
@@ -73,43 +73,72 @@ std::shared_ptr<const Table> small_table(const ImageF& image) {
   return analyze(ExemplarSet::create(std::move(in)).value(), p).value().table;
 }
 
-TEST(PlaneSampling, TablesPreferCubicOnlyWithoutPixelDetailAndRegionsOnlyWhenAllDo) {
+TEST(VoxelSampling, TablesPreferCubicOnlyWithoutPixelDetailAndRegionsOnlyWhenAllDo) {
   const auto blobs = small_table(wave(32, 32));
   const auto speckle = small_table(white_noise(32, 32));
   EXPECT_LT(fine_detail_share(*blobs), kCubicMaxFineDetailShare);
   EXPECT_GE(fine_detail_share(*speckle), kCubicMaxFineDetailShare);
-  EXPECT_EQ(preferred_plane_sampling(*blobs), PlaneSampling::kCubic);
-  EXPECT_EQ(preferred_plane_sampling(*speckle), PlaneSampling::kNearest);
-  EXPECT_EQ(preferred_plane_sampling(std::vector<const Table*>{blobs.get()}), PlaneSampling::kCubic);
-  EXPECT_EQ(preferred_plane_sampling(std::vector<const Table*>{blobs.get(), speckle.get()}), PlaneSampling::kNearest);
-  EXPECT_EQ(preferred_plane_sampling(std::vector<const Table*>{}), PlaneSampling::kNearest);
+  EXPECT_EQ(preferred_voxel_sampling(*blobs), VoxelSampling::kCubic);
+  EXPECT_EQ(preferred_voxel_sampling(*speckle), VoxelSampling::kNearest);
+  EXPECT_EQ(preferred_voxel_sampling(std::vector<const Table*>{blobs.get()}), VoxelSampling::kCubic);
+  EXPECT_EQ(preferred_voxel_sampling(std::vector<const Table*>{blobs.get(), speckle.get()}), VoxelSampling::kNearest);
+  EXPECT_EQ(preferred_voxel_sampling(std::vector<const Table*>{}), VoxelSampling::kNearest);
 }
 
-TEST(PlaneSampling, AutoTakesThePreferredSamplingAndNeverRefusesWhatNearestTakes) {
+TEST(VoxelSampling, AutoTakesThePreferredSamplingAndNeverRefusesWhatNearestTakes) {
   const WorldPoint o{0.5, 2, 3}, u{0.6, 0.8, 0}, v{-0.48, 0.36, 0.8};
-  EXPECT_EQ(TargetSet::plane_cut(o, u, v, 16, 16, std::nullopt, PlaneSampling::kCubic).value().sampling(),
-            PlaneSampling::kCubic);
-  EXPECT_EQ(TargetSet::plane_cut(o, u, v, 16, 16, std::nullopt, PlaneSampling::kNearest).value().sampling(),
-            PlaneSampling::kNearest);
-  EXPECT_EQ(TargetSet::plane_cut(o, u, v, 16, 16, PlaneSampling::kNearest, PlaneSampling::kCubic).value().sampling(),
-            PlaneSampling::kNearest);
+  EXPECT_EQ(TargetSet::plane_cut(o, u, v, 16, 16, std::nullopt, VoxelSampling::kCubic).value().sampling(),
+            VoxelSampling::kCubic);
+  EXPECT_EQ(TargetSet::plane_cut(o, u, v, 16, 16, std::nullopt, VoxelSampling::kNearest).value().sampling(),
+            VoxelSampling::kNearest);
+  EXPECT_EQ(TargetSet::plane_cut(o, u, v, 16, 16, VoxelSampling::kNearest, VoxelSampling::kCubic).value().sampling(),
+            VoxelSampling::kNearest);
   // Past the cubic bounds (kMaxResampledSamples pixels): cubic is refused, auto samples nearest.
   const int w = 2048, h = int(kMaxResampledSamples / w) + 1;
-  const auto refused = TargetSet::plane_cut(o, u, v, w, h, PlaneSampling::kCubic, PlaneSampling::kCubic);
+  const auto refused = TargetSet::plane_cut(o, u, v, w, h, VoxelSampling::kCubic, VoxelSampling::kCubic);
   ASSERT_FALSE(refused);
   EXPECT_EQ(refused.status().code(), StatusCode::kTooLarge);
-  const auto fallback = TargetSet::plane_cut(o, u, v, w, h, std::nullopt, PlaneSampling::kCubic);
+  const auto fallback = TargetSet::plane_cut(o, u, v, w, h, std::nullopt, VoxelSampling::kCubic);
   ASSERT_TRUE(fallback) << fallback.status().message();
-  EXPECT_EQ(fallback.value().sampling(), PlaneSampling::kNearest);
+  EXPECT_EQ(fallback.value().sampling(), VoxelSampling::kNearest);
   // Other errors are not hidden by the fallback.
-  EXPECT_EQ(TargetSet::plane_cut({NAN, 0, 0}, u, v, 16, 16, std::nullopt, PlaneSampling::kCubic).status().field(),
+  EXPECT_EQ(TargetSet::plane_cut({NAN, 0, 0}, u, v, 16, 16, std::nullopt, VoxelSampling::kCubic).status().field(),
             "origin");
+}
+
+TEST(VoxelSampling, PointsOnAPlaneResampleExactlyLikeThePlaneCut) {
+  const WorldPoint o{0.5, 2, 3}, u{0.6, 0.8, 0}, v{-0.48, 0.36, 0.8};
+  const int w = 12, h = 9;
+  std::vector<WorldPoint> pts;
+  for (int j = 0; j < h; ++j)
+    for (int i = 0; i < w; ++i) pts.push_back({o.x + i * u.x + j * v.x, o.y + i * u.y + j * v.y, o.z + i * u.z + j * v.z});
+  for (VoxelSampling s : {VoxelSampling::kNearest, VoxelSampling::kCubic}) {
+    const TargetSet cut = TargetSet::plane_cut(o, u, v, w, h, s).value();
+    const TargetSet at_points = TargetSet::points(pts, s).value();
+    EXPECT_EQ(at_points.voxels, cut.voxels);
+    EXPECT_EQ(at_points.sample, cut.sample);
+    EXPECT_EQ(at_points.resample_floor, cut.resample_floor);
+    EXPECT_EQ(at_points.resample_t, cut.resample_t);
+    EXPECT_EQ(at_points.sampling(), s);
+  }
+  // On voxel centres cubic reads the voxel alone.
+  const TargetSet on_voxels = TargetSet::points({{1, 2, 3}, {-4, 0, 7}}, VoxelSampling::kCubic).value();
+  EXPECT_EQ(on_voxels.voxels, (std::vector<Voxel>{{-4, 0, 7}, {1, 2, 3}}));
+  // Scattered points share no taps: past the voxel bound cubic is refused naming points, and
+  // auto falls back to nearest.
+  std::vector<WorldPoint> scattered;
+  for (int k = 0; k < 140000; ++k) scattered.push_back({k * 7.0 + 0.3, 0.5, 0.5});  // 64 taps each
+  const auto refused = TargetSet::points(scattered, VoxelSampling::kCubic);
+  ASSERT_FALSE(refused);
+  EXPECT_EQ(refused.status().code(), StatusCode::kTooLarge);
+  EXPECT_EQ(refused.status().field(), "points");
+  EXPECT_EQ(TargetSet::points(scattered, std::nullopt, VoxelSampling::kCubic).value().sampling(), VoxelSampling::kNearest);
 }
 
 // The measurement the threshold rests on (README, Quality, "Oblique cuts"): cubic resampling
 // made the oblique 256^2 cut better on these five shared exemplars and worse on the other five.
 // Their shares, by texmetric's pyramid over their 8-bit sRGB pixels: 0.27-0.40 and 0.46-0.68.
-TEST(PlaneSampling, SharedExemplarsSplitAsMeasured) {
+TEST(VoxelSampling, SharedExemplarsSplitAsMeasured) {
   if (testing::exemplar_path("pebbles.png").empty())
     GTEST_SKIP() << "../shared/data/exemplars is absent: real-exemplar test skipped";
   const std::map<std::string, bool> cubic_was_better = {

@@ -1,4 +1,4 @@
-#include "synthesis/plane_sampling.h"
+#include "synthesis/voxel_sampling.h"
 
 #include <array>
 #include <vector>
@@ -57,14 +57,14 @@ double share(double e0, double e1) { return e0 + e1 > 0 ? e0 / (e0 + e1) : 0.0; 
 
 }  // namespace
 
-Result<std::optional<PlaneSampling>> parse_plane_sampling(const std::string& name, const std::string& field) {
-  if (name == "auto") return std::optional<PlaneSampling>();
-  if (name == "nearest") return std::optional<PlaneSampling>(PlaneSampling::kNearest);
-  if (name == "cubic") return std::optional<PlaneSampling>(PlaneSampling::kCubic);
+Result<std::optional<VoxelSampling>> parse_voxel_sampling(const std::string& name, const std::string& field) {
+  if (name == "auto") return std::optional<VoxelSampling>();
+  if (name == "nearest") return std::optional<VoxelSampling>(VoxelSampling::kNearest);
+  if (name == "cubic") return std::optional<VoxelSampling>(VoxelSampling::kCubic);
   return Status(StatusCode::kInvalidArgument, "must be auto, nearest or cubic", field);
 }
 
-const char* plane_sampling_name(PlaneSampling s) { return s == PlaneSampling::kCubic ? "cubic" : "nearest"; }
+const char* voxel_sampling_name(VoxelSampling s) { return s == VoxelSampling::kCubic ? "cubic" : "nearest"; }
 
 double fine_detail_share(const ImageF& linear_rgb) {
   const auto e = band_energies(linear_rgb);
@@ -84,14 +84,14 @@ double fine_detail_share(const Table& table) {
   return share(e0, e1);
 }
 
-PlaneSampling preferred_plane_sampling(const Table& table) {
-  return fine_detail_share(table) < kCubicMaxFineDetailShare ? PlaneSampling::kCubic : PlaneSampling::kNearest;
+VoxelSampling preferred_voxel_sampling(const Table& table) {
+  return fine_detail_share(table) < kCubicMaxFineDetailShare ? VoxelSampling::kCubic : VoxelSampling::kNearest;
 }
 
-PlaneSampling preferred_plane_sampling(const std::vector<const Table*>& tables) {
+VoxelSampling preferred_voxel_sampling(const std::vector<const Table*>& tables) {
   for (const Table* t : tables)
-    if (preferred_plane_sampling(*t) == PlaneSampling::kNearest) return PlaneSampling::kNearest;
-  return tables.empty() ? PlaneSampling::kNearest : PlaneSampling::kCubic;
+    if (preferred_voxel_sampling(*t) == VoxelSampling::kNearest) return VoxelSampling::kNearest;
+  return tables.empty() ? VoxelSampling::kNearest : VoxelSampling::kCubic;
 }
 
 }  // namespace solidtex
