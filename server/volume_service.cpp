@@ -757,6 +757,8 @@ Result<QueryResult> VolumeService::query(const std::string& id, const std::strin
   SynthesisOptions options;
   options.max_bytes = impl_->config.max_request_bytes;
   options.level = level;
+  // What a refusal for size names: the request's own field.
+  options.target_field = kind == "points" ? "points" : kind == "surface" ? "mesh" : "size";
   if (state->regions && level >= 0) return Status(StatusCode::kNotFound, "region volumes serve the finest level only", "level");
   if (state->regions) {
     SOLIDTEX_ASSIGN_OR_RETURN(out.rgb, state->regions->synthesize(target, interrupter, &per_region, options));

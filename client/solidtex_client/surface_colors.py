@@ -50,8 +50,9 @@ class SurfaceColors:
 
 
 def _too_large(error: SolidtexError) -> bool:
-    """The service refused a points request for its size: 422 over the working-memory limit
-    (field ``size``) or ``--max-voxels`` (field ``points``), 413 over the upload limit."""
+    """The service refused a points request for its size: 422 over the working-memory limit or
+    ``--max-voxels`` (field ``points``; servers before this one named the memory limit ``size``),
+    413 over the upload limit."""
     return isinstance(error, PayloadTooLarge) or (
         isinstance(error, Unprocessable) and error.field in ("size", "points"))
 

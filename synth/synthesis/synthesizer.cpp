@@ -132,11 +132,11 @@ TargetSet piece_target(const TargetSet& target, const std::vector<uint32_t>& pie
   return TargetSet::from_voxels(voxels, int(voxels.size()), 1);
 }
 
-Status too_much_memory(int64_t bytes, int64_t limit) {
+Status too_much_memory(int64_t bytes, int64_t limit, const std::string& field) {
   return Status(StatusCode::kUnprocessable,
                 "this request needs up to " + std::to_string(bytes >> 20) + " MB of working memory; the limit is " +
                     std::to_string(limit >> 20) + " MB (ask for a smaller or thinner cut or box, or closer points)",
-                "size");
+                field);
 }
 
 void add_stats(SynthesisStats& into, const SynthesisStats& piece) {
@@ -354,7 +354,7 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize_piece(const Ta
     SOLIDTEX_ASSIGN_OR_RETURN(const std::vector<int> spread, this->spread(poller));
     const RequestCost cost = estimate_cost(schedules_, impl_->stencils, spread, target);
     stats.estimated_bytes = cost.bytes;
-    if (cost.bytes > options.max_bytes) return too_much_memory(cost.bytes, options.max_bytes);
+    if (cost.bytes > options.max_bytes) return too_much_memory(cost.bytes, options.max_bytes, options.target_field);
   }
 
   // Backwards: what the target depends on.
@@ -373,7 +373,7 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize_piece(const Ta
   if (options.dependencies_only) return std::vector<std::array<float, 3>>{};
   if (options.max_bytes > 0) {
     const int64_t bytes = store_bytes(schedules_, deps);
-    if (bytes > options.max_bytes) return too_much_memory(bytes, options.max_bytes);
+    if (bytes > options.max_bytes) return too_much_memory(bytes, options.max_bytes, options.target_field);
   }
 
   // Forwards, coarsest level first, inside the sets.

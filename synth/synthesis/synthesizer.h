@@ -17,6 +17,7 @@
 
 #include <array>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "field/frame_field.h"
@@ -61,6 +62,9 @@ struct SynthesisOptions {
   // (cost_model.h) or whose computed sets need more is refused with kUnprocessable before
   // anything that size is allocated.
   int64_t max_bytes = 0;
+  // The request field that refusal names: what sets the target's size ("size" for cuts and
+  // boxes, "points", "mesh"...).
+  std::string target_field = "size";
   // The pyramid level the target's voxels lie on: -1 (default) is the finest; a coarser level
   // (0 = coarsest) gives that level's final voxels and synthesizes nothing finer. Their colors
   // are output colors of the level's triples (synthesis levels, not box-filtered finest voxels);

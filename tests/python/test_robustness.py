@@ -242,6 +242,22 @@ def test_cut_resample_takes_its_three_names_only_and_cubic_is_bounded(srv):
     alive(srv)
 
 
+def test_points_refused_for_their_cost_name_points(srv):
+    # 140,000 points 7 voxels apart: cubic would read 64 voxels each (past its 8 Mi bound), and
+    # each point alone costs its own dependency cone; both refusals name the points, at once
+    vid = create_volume(srv).json()["id"]
+    n = 140000
+    pts = np.stack([np.arange(n) * 7.0 + 0.3, np.full(n, 0.5), np.full(n, 0.5)], 1).astype("<f4")
+    for resample, words in (("cubic", "cubic resampling"), ("auto", "MB of working memory"), (None, "MB of working memory")):
+        t0 = time.monotonic()
+        r = requests.post(f"{srv.url}/v1/volumes/{vid}/points", params={"resample": resample, "timeout": 10},
+                          data=pts.tobytes(), headers={"Content-Type": "application/octet-stream"}, timeout=HTTP_TIMEOUT)
+        err = assert_error(r, 422, field_contains="points")
+        assert words in err["message"], (resample, err)
+        assert time.monotonic() - t0 < 5
+    alive(srv)
+
+
 def test_overflowing_field_grid_is_refused(srv):
     sketch = {"domain": {"min": [0, 0, 0], "max": [1.1e9, 1, 1]},
               "curves": [{"axis": "x", "plane_normal": [0, 0, 1], "points": [[0, 0, 0], [10, 0.5, 0.5]]}]}
