@@ -5,7 +5,7 @@
     solidtex-client volume --exemplar ID [--field-id ID | --field-spec SPEC] [--seed S] [--scheme S]
     solidtex-client slice VOLUME --axis z --at K --size W,H [--origin U,V] [--scale S] -o OUT.png
     solidtex-client region VOLUME --min X,Y,Z --size W,H,D -o OUT.vdb|OUT.npy
-    solidtex-client points VOLUME POINTS.npy|POINTS.txt -o OUT.npy|OUT.txt
+    solidtex-client points VOLUME POINTS.npy|POINTS.txt [--resample auto|nearest|cubic] -o OUT.npy|OUT.txt
     solidtex-client mesh MESH.obj|.ply|.off [--name N]
     solidtex-client render MESH --volume ID -o VIEW.png [--colors pixel|vertex --azimuth A
                     --elevation E --size W,H --resolution R --margin M --no-light --up y|z
@@ -123,6 +123,8 @@ def _parser() -> argparse.ArgumentParser:
     pt.add_argument("volume")
     pt.add_argument("points", help=".npy (N x 3) or text, one 'x y z' (or x,y,z) per line")
     pt.add_argument("--timeout", type=float, help="server deadline, seconds")
+    pt.add_argument("--resample", choices=["auto", "nearest", "cubic"],
+                    help="nearest voxel (the server's default), Catmull-Rom resampling, or what the volume's cuts use")
     pt.add_argument("-o", "--output", required=True, help=".npy or .txt")
 
     me = sub.add_parser("mesh", help="store a mesh (OBJ, PLY or OFF) and print its summary")
@@ -241,7 +243,7 @@ def _run(args: argparse.Namespace) -> None:
             with open(args.output, "wb") as f:
                 f.write(data)
     elif args.command == "points":
-        rgb = client.points(args.volume, _load_points(args.points), timeout=args.timeout)
+        rgb = client.points(args.volume, _load_points(args.points), timeout=args.timeout, resample=args.resample)
         if args.output.endswith(".txt"):
             np.savetxt(args.output, rgb, fmt="%.9g")
         else:

@@ -57,6 +57,15 @@ def test_cli_upload_field_volume_region_points(shared, exemplars, tmp_path):
     assert np.array_equal(rgb[0], box[0, 0, 0])
     assert np.array_equal(rgb[1], box[3, 4, 5])
     assert np.array_equal(rgb[2], box[0, 1, 2])
+    # on voxel centres cubic resampling is the voxel; between them it blends its neighbours
+    out_cubic = tmp_path / "rgb_cubic.npy"
+    client_cli(url, "points", vol["id"], pts, "--resample", "cubic", "-o", out_cubic)
+    assert np.array_equal(np.load(out_cubic), rgb)
+    half = tmp_path / "half.txt"
+    half.write_text("2.5 1 0\n")
+    client_cli(url, "points", vol["id"], half, "--resample", "cubic", "-o", out_cubic)
+    blended = np.load(out_cubic)[0]
+    assert not np.array_equal(blended, box[0, 1, 2]) or np.array_equal(box[0, 1, 2], box[0, 1, 3])
 
 
 def test_cli_slice_scale_is_the_clients(shared, tmp_path):
