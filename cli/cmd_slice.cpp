@@ -153,9 +153,9 @@ Status run_slice(const std::vector<std::string>& argv) {
     SOLIDTEX_ASSIGN_OR_RETURN(auto table2, load_table(*second));
     tables.push_back(table2);
   }
-  std::vector<const Table*> cut_tables;
-  for (const auto& t : tables) cut_tables.push_back(t.get());
-  const VoxelSampling preferred = preferred_voxel_sampling(cut_tables);
+  // Only a plane cut left to auto needs the tables' preference (it reads their exemplars).
+  const VoxelSampling preferred =
+      cut.plane && !cut.resample ? preferred_voxel_sampling(tables) : VoxelSampling::kNearest;
   SOLIDTEX_ASSIGN_OR_RETURN(const TargetSet target, build_cut(cut, preferred));
   ProgressBar bar;
   SynthesisStats stats;

@@ -292,9 +292,7 @@ struct VolumeService::Impl {
       SOLIDTEX_ASSIGN_OR_RETURN(st->regions, RegionVolume::create(st->synths, label));
       st->synthesizer_bytes += int64_t(sizeof(RegionVolume));
     }
-    std::vector<const Table*> tables;
-    for (const auto& t : st->tables) tables.push_back(t.get());
-    st->sampling = solidtex::preferred_voxel_sampling(tables);
+    st->sampling = solidtex::preferred_voxel_sampling(st->tables);
     st->field_bytes = field_resident_bytes(*st->field);
     st->surface_bytes = st->surface ? st->surface->resident_bytes() : 0;
     return st;

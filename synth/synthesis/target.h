@@ -11,7 +11,6 @@
 #include <array>
 #include <cstdint>
 #include <optional>
-#include <string>
 #include <vector>
 
 #include "core/status.h"
@@ -31,7 +30,7 @@ inline constexpr int64_t kMaxResampledVoxels = int64_t(1) << 23;
 struct TargetSet {
   std::vector<Voxel> voxels;        // distinct finest voxels, sorted
   std::vector<uint32_t> sample;     // output sample -> index into voxels (its nearest voxel)
-  // Resampled targets (plane cuts) only, else empty (`sample` is exact): sample s lies at
+  // Resampled targets (plane cuts, points) only, else empty (`sample` is exact): sample s lies at
   // resample_floor[s] + resample_t[s] (t in [0, 1) per axis); its taps are the voxels
   // floor - 1 .. floor + 2 per axis that have a non-zero weight, all in `voxels`.
   std::vector<Voxel> resample_floor;

@@ -88,8 +88,8 @@ VoxelSampling preferred_voxel_sampling(const Table& table) {
   return fine_detail_share(table) < kCubicMaxFineDetailShare ? VoxelSampling::kCubic : VoxelSampling::kNearest;
 }
 
-VoxelSampling preferred_voxel_sampling(const std::vector<const Table*>& tables) {
-  for (const Table* t : tables)
+VoxelSampling preferred_voxel_sampling(const std::vector<std::shared_ptr<const Table>>& tables) {
+  for (const auto& t : tables)
     if (preferred_voxel_sampling(*t) == VoxelSampling::kNearest) return VoxelSampling::kNearest;
   return tables.empty() ? VoxelSampling::kNearest : VoxelSampling::kCubic;
 }

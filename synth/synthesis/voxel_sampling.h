@@ -12,6 +12,7 @@
 // Everything here is a pure function of its arguments; thread-safe.
 #pragma once
 
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -47,6 +48,6 @@ inline constexpr double kCubicMaxFineDetailShare = 0.43;
 VoxelSampling preferred_voxel_sampling(const Table& table);
 // Of a volume of several tables (a region volume): kCubic only when every table prefers it,
 // so that an exemplar with 1-voxel detail keeps it.
-VoxelSampling preferred_voxel_sampling(const std::vector<const Table*>& tables);
+VoxelSampling preferred_voxel_sampling(const std::vector<std::shared_ptr<const Table>>& tables);
 
 }  // namespace solidtex

@@ -80,9 +80,9 @@ TEST(VoxelSampling, TablesPreferCubicOnlyWithoutPixelDetailAndRegionsOnlyWhenAll
   EXPECT_GE(fine_detail_share(*speckle), kCubicMaxFineDetailShare);
   EXPECT_EQ(preferred_voxel_sampling(*blobs), VoxelSampling::kCubic);
   EXPECT_EQ(preferred_voxel_sampling(*speckle), VoxelSampling::kNearest);
-  EXPECT_EQ(preferred_voxel_sampling(std::vector<const Table*>{blobs.get()}), VoxelSampling::kCubic);
-  EXPECT_EQ(preferred_voxel_sampling(std::vector<const Table*>{blobs.get(), speckle.get()}), VoxelSampling::kNearest);
-  EXPECT_EQ(preferred_voxel_sampling(std::vector<const Table*>{}), VoxelSampling::kNearest);
+  EXPECT_EQ(preferred_voxel_sampling(std::vector<std::shared_ptr<const Table>>{blobs}), VoxelSampling::kCubic);
+  EXPECT_EQ(preferred_voxel_sampling(std::vector<std::shared_ptr<const Table>>{blobs, speckle}), VoxelSampling::kNearest);
+  EXPECT_EQ(preferred_voxel_sampling(std::vector<std::shared_ptr<const Table>>{}), VoxelSampling::kNearest);
 }
 
 TEST(VoxelSampling, AutoTakesThePreferredSamplingAndNeverRefusesWhatNearestTakes) {
