@@ -255,6 +255,15 @@ def test_points_refused_for_their_cost_name_points(srv):
         err = assert_error(r, 422, field_contains="points")
         assert words in err["message"], (resample, err)
         assert time.monotonic() - t0 < 5
+    # past cubic's 1024^2 samples: cubic is refused at once, auto samples nearest (here too
+    # costly as well, refused naming the points)
+    n = 1100000
+    dense = np.stack([np.arange(n) % 1000 + 0.5, np.arange(n) // 1000 + 0.5, np.full(n, 0.5)], 1).astype("<f4")
+    for resample, words in (("cubic", "at most 1048576 points"), ("auto", "MB of working memory")):
+        r = requests.post(f"{srv.url}/v1/volumes/{vid}/points", params={"resample": resample, "timeout": 10},
+                          data=dense.tobytes(), headers={"Content-Type": "application/octet-stream"}, timeout=HTTP_TIMEOUT)
+        err = assert_error(r, 422, field_contains="points")
+        assert words in err["message"], (resample, err)
     alive(srv)
 
 
