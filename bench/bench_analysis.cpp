@@ -41,7 +41,7 @@ int main(int argc, char** argv) {
     std::cerr << set.status().to_string() << "\n";
     return 1;
   }
-  AnalysisParams params;  // defaults: 4 levels, N = 9, N_T = 12, 20 PCA dims
+  AnalysisParams params;  // defaults: levels auto (from the exemplar's size), N = 9, N_T = 12, 20 PCA dims
   auto r = analyze(*set, params);
   if (!r) {
     std::cerr << r.status().to_string() << "\n";
@@ -61,7 +61,7 @@ int main(int argc, char** argv) {
   j["source"] = source;
   j["width"] = set->plane(Plane::kXY).width;
   j["height"] = set->plane(Plane::kXY).height;
-  j["levels"] = params.levels;
+  j["levels"] = r->table->params().levels;
   j["seconds"] = r->seconds;
   j["balance_seconds"] = balance_seconds;
   j["total_seconds"] = r->seconds + balance_seconds;

@@ -1,5 +1,5 @@
 // solidtex analyze IMAGE [--yz IMAGE --zx IMAGE] [--mask IMAGE [--mask-yz IMAGE --mask-zx IMAGE]]
-//   [--mask-weight W] [--levels 4] [--neighborhood 9] [--candidates 12] [--pca-dims 20]
+//   [--mask-weight W] [--levels auto|L] [--neighborhood 9] [--candidates 12] [--pca-dims 20]
 //   [--search-k 24] [--knn-checks 192] [--balance-rounds 3] [--balance-box 24] [--balance-strength 0.025]
 //   [--balance-fine-gain 2]
 //   [--seed S] [--threads T] [--grain auto|none|x|y|crossed] -o TABLE.stx [--json]
@@ -44,7 +44,12 @@ Status run_analyze(const std::vector<std::string>& argv) {
   SOLIDTEX_ASSIGN_OR_RETURN(std::string out, args.required("-o"));
 
   AnalysisParams params;
-  SOLIDTEX_ASSIGN_OR_RETURN(params.levels, args.get_int("--levels", params.levels, 1, 8));
+  // auto (the default) is kAutoLevels, resolved from the exemplar's size before analysis.
+  if (const auto v = args.get("--levels"); v && *v != "auto") {
+    Result<int> n = args.get_int("--levels", params.levels, 1, 8);
+    if (!n) return Status(StatusCode::kInvalidArgument, "is '" + *v + "'; must be auto or an integer in [1, 8]", "--levels");
+    params.levels = int(*n);
+  }
   SOLIDTEX_ASSIGN_OR_RETURN(params.neighborhood, args.get_int("--neighborhood", params.neighborhood, 3, 15));
   SOLIDTEX_ASSIGN_OR_RETURN(params.candidates, args.get_int("--candidates", params.candidates, 1, 32));
   SOLIDTEX_ASSIGN_OR_RETURN(params.pca_dims, args.get_int("--pca-dims", params.pca_dims, 1, 64));
@@ -112,7 +117,7 @@ Status run_analyze(const std::vector<std::string>& argv) {
                         {"error_ratio", r.random_crossbar_error > 0 ? r.mean_crossbar_error / r.random_crossbar_error : 0.0},
                         {"coherent_fraction", r.coherent_fraction}});
     j["levels"] = levels;
-    j["params"] = {{"levels", params.levels},       {"neighborhood", params.neighborhood},
+    j["params"] = {{"levels", result.table->params().levels},       {"neighborhood", params.neighborhood},
                    {"candidates", params.candidates}, {"pca_dims", params.pca_dims},
                    {"search_k", params.search_k},     {"knn_checks", params.knn_checks},
                    {"seed", params.seed},             {"balance_rounds", balance.rounds},

@@ -24,7 +24,7 @@ namespace {
 constexpr const char* kUsage =
     "usage: solidtex <command> [options]\n"
     "commands:\n"
-    "  analyze IMAGE [--yz IMAGE --zx IMAGE] [--mask IMAGE] [--levels 4] [--neighborhood 9]\n"
+    "  analyze IMAGE [--yz IMAGE --zx IMAGE] [--mask IMAGE] [--levels auto|L] [--neighborhood 9]\n"
     "          [--candidates 12] [--pca-dims 20] [--seed S] [--threads T] [--grain auto|none|x|y|crossed]\n"
     "          [--search-k 24] [--knn-checks 192] [--balance-rounds 3] [--balance-box 24]\n"
     "          [--balance-strength 0.025] [--balance-fine-gain 2]\n"

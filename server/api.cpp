@@ -290,7 +290,12 @@ HttpResponse Api::upload_exemplar(const HttpRequest& r) {
     ExemplarUpload up;
     up.name = q.get("name").value_or("");
     if (utf8_length(up.name) > 200) return Status(StatusCode::kInvalidArgument, "is longer than 200 characters", "name");
-    SOLIDTEX_ASSIGN_OR_RETURN(up.params.levels, q.get_int("levels", up.params.levels, 1, 8));
+    // auto (the default) is kAutoLevels, resolved from the exemplar's size before analysis.
+    if (const auto v = q.get("levels"); v && *v != "auto") {
+      Result<int64_t> n = q.get_int("levels", up.params.levels, 1, 8);
+      if (!n) return Status(StatusCode::kInvalidArgument, "must be auto or an integer in [1, 8]", "levels");
+      up.params.levels = int(*n);
+    }
     SOLIDTEX_ASSIGN_OR_RETURN(up.params.neighborhood, q.get_int("neighborhood", up.params.neighborhood, 3, 15));
     SOLIDTEX_ASSIGN_OR_RETURN(up.params.candidates, q.get_int("candidates", up.params.candidates, 1, 32));
     SOLIDTEX_ASSIGN_OR_RETURN(up.params.pca_dims, q.get_int("pca_dims", up.params.pca_dims, 1, 64));

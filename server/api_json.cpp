@@ -29,7 +29,7 @@ struct Param {
 
 // Both directions of every key, in the order errors are looked for.
 constexpr Param<AnalysisParams> kAnalysisParams[] = {
-    {"levels", &AnalysisParams::levels, 1, 8},
+    {"levels", &AnalysisParams::levels, 0, 8},  // 0: kAutoLevels
     {"neighborhood", &AnalysisParams::neighborhood, 3, 15},
     {"candidates", &AnalysisParams::candidates, 1, 32},
     {"pca_dims", &AnalysisParams::pca_dims, 1, 64},

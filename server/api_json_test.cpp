@@ -26,8 +26,9 @@ std::set<std::string> keys_of(const json& j) {
 }
 
 TEST(ApiJson, WireFormatOfTheDefaults) {
+  // levels 0 is kAutoLevels; uploads store the count it resolves to (ExemplarService::upload).
   EXPECT_EQ(to_json(AnalysisParams{}).dump(),
-            R"({"candidates":12,"knn_checks":192,"levels":4,"neighborhood":9,"pca_dims":20,"search_k":24,"seed":1,)"
+            R"({"candidates":12,"knn_checks":192,"levels":0,"neighborhood":9,"pca_dims":20,"search_k":24,"seed":1,)"
             R"("suggested_plane_weights":[1.0,1.0,1.0]})");
   EXPECT_EQ(to_json(SynthesisParams{}).dump(),
             R"({"balance":1.0,"cell_size":12,"coarse_passes":3,"color":"medoid","finest_subpass_size":1,"init":"auto","init_subpart":32,"matcher":"paper","passes":1,)"
@@ -118,7 +119,7 @@ TEST(ApiJson, ErrorsNameTheField) {
   const Case analysis[] = {
       {json(7), "params", "must be a JSON object"},
       {{{"colour", 1}}, "params.colour", "unknown key"},
-      {{{"levels", 0}}, "params.levels", "must be in [1, 8]"},
+      {{{"levels", 9}}, "params.levels", "must be in [0, 8]"},  // 0 is kAutoLevels
       {{{"seed", -1}}, "params.seed", "must be in [0, 1073741824]"},
       {{{"knn_checks", true}}, "params.knn_checks", "must be an integer"},
       {{{"suggested_plane_weights", "1,1,1"}}, "params.suggested_plane_weights", "must be 3 numbers"},

@@ -291,6 +291,8 @@ struct ExemplarService::Impl {
       ExemplarInputs tiny;
       tiny.xy = ImageF(8, 8, 3);
       if (have_mask) tiny.mask_xy = ImageF(8, 8, 3);
+      // Automatic levels resolve to 1 on this 8x8 probe: fewer than any real image gets, so
+      // still a lower bound; the full estimate follows once the images are decoded.
       if (auto t = ExemplarSet::create(std::move(tiny))) per_pixel = estimate_analysis_bytes(*t, params) / 64;
     }
     int64_t pixels = 0;
@@ -556,6 +558,7 @@ Result<json> ExemplarService::upload(ExemplarUpload up) {
   std::string grain;
   SOLIDTEX_ASSIGN_OR_RETURN(ExemplarSet set, impl_->build_set(up.parts, up.grain, up.mask_weight, params,
                                                                impl_->config.max_request_bytes, &grain));
+  params = resolve_levels(params, set);  // stored and analysed with the level count it resolves to
   if (const int64_t bytes = estimate_analysis_bytes(set, params); bytes > impl_->config.max_request_bytes)
     return Status(StatusCode::kUnprocessable,
                   "analysing this exemplar needs about " + std::to_string(bytes >> 20) + " MB; the limit is " +

@@ -142,3 +142,23 @@ execute_process(COMMAND ${ST} slice ${TMP}/bad.png --axis z --at 0 --size 4,4 -o
 if(rc EQUAL 0 OR NOT err MATCHES "corrupt")
   message(FATAL_ERROR "a non-table input was accepted or the error is unclear: ${err}")
 endif()
+
+# Without --levels (and with --levels auto) the level count follows the exemplar's size: the
+# shorter side 40 takes N = 7 templates to 2 levels (7 * 2^(L-1) <= 20), and the report says so.
+foreach(flag "" "auto")
+  if(flag STREQUAL "")
+    set(extra "")
+  else()
+    set(extra --levels ${flag})
+  endif()
+  execute_process(COMMAND ${ST} analyze ${TMP}/wood.png ${extra} --neighborhood 7 --candidates 4 --pca-dims 8
+    --grain none -o ${TMP}/wood_auto.stx --json RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "analyze ${extra} failed: ${rc} ${err}")
+  endif()
+  string(JSON nlevels LENGTH "${out}" levels)
+  string(JSON plevels GET "${out}" params levels)
+  if(NOT nlevels EQUAL 2 OR NOT plevels EQUAL 2)
+    message(FATAL_ERROR "analyze ${extra}: expected 2 levels for a 48x40 exemplar with N = 7, got ${nlevels} (params ${plevels})")
+  endif()
+endforeach()

@@ -25,7 +25,7 @@ import json
 import os
 import re
 import sys
-from typing import Any, Callable, List, Optional, Sequence
+from typing import Any, Callable, List, Optional, Sequence, Union
 
 import numpy as np
 import requests
@@ -53,6 +53,16 @@ def _ints(n: int):
     return _numbers(n, int, "integers")
 
 
+def _levels(text: str) -> Union[str, int]:
+    """--levels: 'auto' or an integer (the server checks its range and names `levels`)."""
+    if text == "auto":
+        return text
+    try:
+        return int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is neither auto nor an integer") from None
+
+
 def _floats(n: int):
     return _numbers(n, float, "numbers")
 
@@ -74,7 +84,7 @@ def _parser() -> argparse.ArgumentParser:
     up.add_argument("--zx")
     up.add_argument("--mask")
     up.add_argument("--name")
-    up.add_argument("--levels", type=int)
+    up.add_argument("--levels", type=_levels, metavar="auto|L", help="pyramid levels, 1-8; auto (the server's default) follows the image size")
     up.add_argument("--neighborhood", type=int)
     up.add_argument("--candidates", type=int)
     up.add_argument("--pca-dims", type=int)

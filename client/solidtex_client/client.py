@@ -307,7 +307,8 @@ class Client:
         sent as the raw body (``application/octet-stream``); with ``yz``/``zx``/``mask`` the
         body is multipart/form-data with parts ``xy``, ``yz``, ``zx``, ``mask``, ``mask_yz``,
         ``mask_zx`` (feature masks of the three planes).
-        ``analysis_params`` go in the query: ``name``, ``levels``, ``neighborhood`` (odd
+        ``analysis_params`` go in the query: ``name``, ``levels`` (1-8, or ``"auto"``, the
+        server's default, which follows the image size), ``neighborhood`` (odd
         template size in pixels), ``candidates``, ``pca_dims``, ``seed``, ``plane_weights``
         (a 3-sequence or ``"a,b,c"``), ``grain`` (``"auto"`` by default, ``"none"``, ``"x"``, ``"y"``), ``mask_weight``. Returns ``{"exemplar": ..., "job": ...}``.
         """

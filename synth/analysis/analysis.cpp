@@ -1,9 +1,11 @@
 #include "analysis/analysis.h"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <future>
 #include <cmath>
+#include <limits>
 #include <mutex>
 
 #include "analysis/gaussian_stack.h"
@@ -57,8 +59,20 @@ std::vector<LevelReport> level_reports(const Table& table) {
   return out;
 }
 
-Result<AnalysisResult> analyze(const ExemplarSet& exemplars, const AnalysisParams& params, Interrupter& interrupter) {
-  SOLIDTEX_RETURN_IF_ERROR(params.validate());
+AnalysisParams resolve_levels(AnalysisParams params, const ExemplarSet& exemplars) {
+  if (params.levels != kAutoLevels) return params;
+  int side = std::numeric_limits<int>::max();
+  for (int k = 0; k < 3; ++k) {
+    const ImageF& img = exemplars.plane(plane_from_index(k));
+    side = std::min({side, img.width, img.height});
+  }
+  params.levels = auto_levels(side, params.neighborhood);
+  return params;
+}
+
+Result<AnalysisResult> analyze(const ExemplarSet& exemplars, const AnalysisParams& requested, Interrupter& interrupter) {
+  SOLIDTEX_RETURN_IF_ERROR(requested.validate());
+  const AnalysisParams params = resolve_levels(requested, exemplars);
   const auto t0 = std::chrono::steady_clock::now();
   interrupter.start("analyze");
   ProgressSink sink(interrupter);
@@ -121,7 +135,8 @@ Result<AnalysisResult> analyze(const ExemplarSet& exemplars, const AnalysisParam
   return result;
 }
 
-int64_t estimate_analysis_bytes(const ExemplarSet& exemplars, const AnalysisParams& params) {
+int64_t estimate_analysis_bytes(const ExemplarSet& exemplars, const AnalysisParams& requested) {
+  const AnalysisParams params = resolve_levels(requested, exemplars);
   const int64_t planes = exemplars.shared() ? 1 : 3;
   const int64_t c = exemplars.channels();
   const int64_t n = params.neighborhood, nt = params.candidates;

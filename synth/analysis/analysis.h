@@ -28,6 +28,11 @@ struct AnalysisResult {
   double seconds = 0;
 };
 
+// `params` with kAutoLevels replaced by auto_levels() of the exemplars' shorter side (the
+// smallest width or height over the three planes); explicit levels are kept.
+AnalysisParams resolve_levels(AnalysisParams params, const ExemplarSet& exemplars);
+
+// Levels kAutoLevels are resolved first (resolve_levels); the table holds the count used.
 Result<AnalysisResult> analyze(const ExemplarSet& exemplars, const AnalysisParams& params,
                                Interrupter& interrupter = null_interrupter());
 

@@ -1,5 +1,6 @@
 #include "analysis/analysis_params.h"
 
+#include <cstdint>
 #include <string>
 
 namespace solidtex {
@@ -13,8 +14,14 @@ Status range(int v, int lo, int hi, const char* field) {
 }
 }  // namespace
 
+int auto_levels(int shorter_side, int neighborhood) {
+  int levels = 1;
+  while (levels < 8 && (int64_t(neighborhood) << levels) * 2 <= int64_t(shorter_side)) ++levels;
+  return levels;
+}
+
 Status AnalysisParams::validate() const {
-  SOLIDTEX_RETURN_IF_ERROR(range(levels, 1, 8, "levels"));
+  if (levels != kAutoLevels) SOLIDTEX_RETURN_IF_ERROR(range(levels, 1, 8, "levels"));
   SOLIDTEX_RETURN_IF_ERROR(range(neighborhood, 3, 15, "neighborhood"));
   if (neighborhood % 2 == 0)
     return Status(StatusCode::kInvalidArgument, "is " + std::to_string(neighborhood) + "; must be odd", "neighborhood");

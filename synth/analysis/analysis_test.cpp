@@ -47,8 +47,58 @@ TEST(Analysis, InvalidParametersNameTheField) {
   EXPECT_EQ(r.status().code(), StatusCode::kInvalidArgument);
   EXPECT_EQ(r.status().field(), "neighborhood");
   p = AnalysisParams{};
-  p.levels = 0;
+  p.levels = 9;
   EXPECT_EQ(analyze(set, p).status().field(), "levels");
+  p.levels = -1;
+  EXPECT_EQ(analyze(set, p).status().field(), "levels");
+}
+
+// The coarsest template, N * 2^(L-1) pixels wide, spans at most half the shorter side.
+TEST(Analysis, AutoLevelsFollowTheExemplarsShorterSide) {
+  EXPECT_EQ(auto_levels(62, 9), 2);    // leopard
+  EXPECT_EQ(auto_levels(82, 9), 3);    // tree_bark (82 x 90)
+  EXPECT_EQ(auto_levels(96, 9), 3);    // bricks, weave_burlap, wood_grain
+  EXPECT_EQ(auto_levels(128, 9), 3);   // marble_pink
+  EXPECT_EQ(auto_levels(143, 9), 3);   // 72 > 71.5
+  EXPECT_EQ(auto_levels(144, 9), 4);   // 72 <= 72
+  EXPECT_EQ(auto_levels(256, 9), 4);   // pebbles, wood_planks: what the old fixed default gave
+  EXPECT_EQ(auto_levels(512, 9), 5);   // gravel
+  EXPECT_EQ(auto_levels(256, 5), 5);
+  EXPECT_EQ(auto_levels(16, 9), 1);    // too small for a second level
+  EXPECT_EQ(auto_levels(1 << 30, 15), 8);
+  for (int side = 8; side <= 4096; ++side)
+    for (int n = 3; n <= 15; n += 2) {
+      const int l = auto_levels(side, n);
+      ASSERT_GE(l, 1);
+      ASSERT_LE(l, 8);
+      if (l > 1) ASSERT_LE(2 * n << (l - 1), side) << side << " " << n;
+      if (l < 8) ASSERT_GT(2 * n << l, side) << side << " " << n;
+    }
+}
+
+TEST(Analysis, AutoLevelsAreResolvedFromTheSmallestPlaneAndStored) {
+  ExemplarInputs in;
+  in.xy = testing::procedural(ProceduralKind::kNoise, 64, 40);
+  in.yz = testing::procedural(ProceduralKind::kNoise, 64, 64);
+  in.zx = testing::procedural(ProceduralKind::kNoise, 36, 64);
+  auto set = ExemplarSet::create(std::move(in)).value();
+  AnalysisParams p = fast_params();
+  p.levels = kAutoLevels;
+  EXPECT_EQ(resolve_levels(p, set).levels, auto_levels(36, 7));
+  EXPECT_EQ(auto_levels(36, 7), 2);
+  p.levels = 3;
+  EXPECT_EQ(resolve_levels(p, set).levels, 3);  // explicit counts are kept
+  p.levels = kAutoLevels;
+  const auto table = analyze(set, p).value().table;
+  EXPECT_EQ(table->levels(), 2);
+  EXPECT_EQ(table->params().levels, 2);
+  p.levels = 2;  // auto is exactly that count: the same table, bit for bit
+  EXPECT_EQ(encode_table(*table), encode_table(*analyze(set, p).value().table));
+  AnalysisParams automatic = p;
+  automatic.levels = kAutoLevels;
+  EXPECT_EQ(estimate_analysis_bytes(set, automatic), estimate_analysis_bytes(set, p));
+  p.levels = 3;
+  EXPECT_GT(estimate_analysis_bytes(set, p), estimate_analysis_bytes(set, automatic));
 }
 
 TEST(Analysis, ExemplarSetValidation) {

@@ -29,6 +29,8 @@ Result<std::shared_ptr<const Table>> Table::assemble(AnalysisParams params, Exem
                                                      std::vector<std::array<PcaBasis, 3>> pca_per_level,
                                                      std::vector<LevelCandidates> candidates) {
   SOLIDTEX_RETURN_IF_ERROR(params.validate());
+  if (params.levels == kAutoLevels)
+    return Status(StatusCode::kInvalidArgument, "must be resolved before a table is assembled (resolve_levels)", "levels");
   const int L = params.levels;
   if (int(pca_per_level.size()) != L || int(candidates.size()) != L)
     return Status(StatusCode::kCorrupt, "level count does not match the parameters");

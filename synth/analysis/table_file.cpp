@@ -140,6 +140,7 @@ Result<std::shared_ptr<const Table>> decode_table(std::span<const uint8_t> bytes
   SOLIDTEX_RETURN_IF_ERROR(r.u32(p.seed));
   for (float& pw : p.suggested_plane_weights) SOLIDTEX_RETURN_IF_ERROR(r.f32(pw));
   if (Status st = p.validate(); !st) return corrupt("stored parameters are invalid: " + st.to_string());
+  if (p.levels == kAutoLevels) return corrupt("stored level count is 0 (tables hold the count used)");
   uint8_t shared = 0, has_mask = 0;
   SOLIDTEX_RETURN_IF_ERROR(r.u8(shared));
   SOLIDTEX_RETURN_IF_ERROR(r.u8(has_mask));

@@ -80,3 +80,17 @@ def test_cli_slice_scale_is_the_clients(shared, tmp_path):
                       "--size", "4,4", "--scale", levels, "-o", tmp_path / "x.png", check=False)
     assert proc.returncode == 1 and proc.stderr.startswith("error: not_found: "), proc.stderr
     assert "(scale)" in proc.stderr and not (tmp_path / "x.png").exists()
+
+
+def test_cli_upload_levels_auto_or_an_integer(shared, exemplars):
+    """--levels auto leaves the count to the server (64^2 with N = 5: 3 levels); a word that is
+    neither auto nor an integer is refused by the command line before anything is sent."""
+    url = shared.server.url
+    small = ["--neighborhood", "5", "--candidates", "4", "--pca-dims", "8", "--wait"]
+    up = json.loads(client_cli(url, "upload", exemplars["noise"], "--levels", "auto", *small).stdout)
+    got = shared.client.get_exemplar(up["exemplar"]["id"])
+    assert got["params"]["levels"] == 3 and len(got["levels"]) == 3, got
+    proc = client_cli(url, "upload", exemplars["noise"], "--levels", "many", *small, check=False)
+    assert proc.returncode == 2 and "neither auto nor an integer" in proc.stderr, proc.stderr
+    proc = client_cli(url, "upload", exemplars["noise"], "--levels", "9", *small, check=False)
+    assert proc.returncode == 1 and "levels" in proc.stderr, proc.stderr

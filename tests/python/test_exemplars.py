@@ -1,7 +1,7 @@
 """Exemplar upload, background analysis, table download and bit identity with the CLI."""
 import numpy as np
 
-from support import ANALYSIS, ANALYSIS_CLI, file_pixels, post_bytes, run_cli, upload_ready
+from support import ANALYSIS, ANALYSIS_CLI, assert_error, file_pixels, post_bytes, run_cli, upload_ready
 from solidtex_client import encode_png
 
 
@@ -111,3 +111,33 @@ def test_numpy_upload_is_sent_as_png(shared, exemplars, tmp_path):
     cli = tmp_path / "noise.stx"
     run_cli("analyze", png, *ANALYSIS_CLI, "-o", cli)
     assert c.get_exemplar_table(got["id"]) == cli.read_bytes()
+
+
+def test_levels_default_to_the_exemplars_size(shared, tmp_path):
+    """Without `levels` (or with levels=auto) the pyramid gets the most levels whose coarsest
+    template spans at most half the exemplar's shorter side (auto_levels); the stored record and
+    the table hold the count used, and it equals asking for that count. Anything else is a 400
+    naming levels."""
+    c = shared.client
+    rng = np.random.default_rng(3)
+    img = tmp_path / "e.png"
+    img.write_bytes(encode_png((rng.random((48, 80, 3)) * 255).astype(np.uint8)))
+    small = {k: v for k, v in ANALYSIS.items() if k != "levels"}  # N = 5: 5*2^(L-1) <= 24 -> L = 3
+
+    def ready(**params):
+        up = c.upload_exemplar(img, grain="none", **params)
+        c.wait_for_job(up["job"]["id"], timeout=120, poll=0.1)
+        return c.get_exemplar(up["exemplar"]["id"])
+
+    default = ready(**small)
+    auto = ready(**small, levels="auto")
+    three = ready(**small, levels=3)
+    for ex in (default, auto):
+        assert len(ex["levels"]) == 3 and ex["params"]["levels"] == 3, ex
+    tables = [c.get_exemplar_table(ex["id"]) for ex in (default, auto, three)]
+    assert tables[0] == tables[1] == tables[2]
+    two = ready(**small, levels=2)
+    assert len(two["levels"]) == 2 and c.get_exemplar_table(two["id"]) != tables[0]
+    for bad in ("autos", "0", "9", "3.5", ""):
+        r = post_bytes(shared.server.url + "/v1/exemplars", img.read_bytes(), params={**small, "levels": bad})
+        assert_error(r, 400, "invalid_argument", "levels")

@@ -179,7 +179,9 @@ def test_upload_analyse_create_and_see_the_slice_endpoints_pixels(app_page, app,
     page = p.page
     page.set_input_files("#exemplar-file", str(exemplars["spots"]))
     page.click("#analysis-details summary")
-    for field, value in (("levels", 3), ("neighborhood", 5), ("candidates", 4), ("pca-dims", 8)):
+    # levels stays at auto, the form's default: 64^2 with N = 5 resolves to 3 (auto_levels)
+    assert page.input_value("#analysis-levels") == "auto"
+    for field, value in (("neighborhood", 5), ("candidates", 4), ("pca-dims", 8)):
         page.fill(f"#analysis-{field}", str(value))
     page.click("#exemplar-upload")
     page.wait_for_function("() => document.getElementById('analysis-status').textContent.includes('ready')", timeout=WAIT_MS)
