@@ -119,7 +119,7 @@ REVISION_409 = ("`revision` was given and the field is at another revision: noth
 scale_param = qp("scale", "Dataset s of the volume's pyramid, as /zarr's: 0 (default) the finest voxels; s > 0 synthesis level L-1-s, whose voxels are 2^s finest voxels wide (voxel i covers finest voxels [i*2^s, (i+1)*2^s)) and are that level's own colours, not filters of finer ones; nothing finer is synthesized, so coarse cuts are fast previews. Coordinates and sizes are then in that dataset's voxels. Past the volume's coarsest dataset (L-1; region volumes have dataset 0 only): 404.", integer(0, 7, default=0))
 analysis_params = [
     qp("name", "Free-form label, at most 200 characters.", {"type": "string", "maxLength": 200}),
-    qp("levels", "Pyramid levels L, or 'auto' (default): the most levels whose coarsest template (N * 2^(L-1) pixels) spans at most half the exemplar's shorter side, e.g. 2 for 64^2, 3 for 96^2 to 143^2, 4 for 144^2 to 287^2, 5 for 512^2 with N = 9. The exemplar's `params.levels` and `levels` report the count used.",
+    qp("levels", "Pyramid levels L, or 'auto' (default): the most levels whose coarsest template (N * 2^(L-1) pixels) spans at most half the exemplar's shorter side, with N = 9: 2 for shorter sides of 36 to 71 pixels, 3 for 72 to 143, 4 for 144 to 287, 5 for 288 to 575. The exemplar's `params.levels` and `levels` report the count used.",
        {"oneOf": [integer(1, 8), {"type": "string", "enum": ["auto"]}], "default": "auto"}),
     qp("neighborhood", "Template size N (odd).", {"type": "integer", "enum": [3, 5, 7, 9, 11, 13, 15], "default": 9}),
     qp("candidates", "Candidate triples per pixel N_T.", integer(1, 32, default=12)),
