@@ -95,6 +95,27 @@ def test_passes_at_their_documented_extremes(srv):
     alive(srv)
 
 
+def test_levels_at_their_documented_extremes(srv, tmp_path):
+    """levels 1 and 8 analyse a small exemplar and its volume cuts; auto on the smallest
+    exemplar (8x8) resolves to one level and works too; anything else is a 400 naming levels."""
+    rng = np.random.default_rng(5)
+    small, tiny = tmp_path / "small.png", tmp_path / "tiny.png"
+    Image.fromarray((rng.random((40, 40, 3)) * 255).astype(np.uint8)).save(small)
+    Image.fromarray((rng.random((8, 8, 3)) * 255).astype(np.uint8)).save(tiny)
+    other = {k: v for k, v in ANALYSIS.items() if k != "levels"}
+    for image, levels, want in ((small, 1, 1), (small, 8, 8), (tiny, "auto", 1)):
+        ex = upload_ready(srv.client, image, **other, levels=levels, grain="none")
+        assert ex["state"] == "ready" and ex["params"]["levels"] == want and len(ex["levels"]) == want, ex
+        r = requests.post(f"{srv.url}/v1/volumes", json={"exemplar": ex["id"]}, timeout=HTTP_TIMEOUT)
+        assert r.status_code == 201, r.text
+        got = slice_of(srv, r.json()["id"], size="8,8")
+        assert got.status_code == 200, got.text
+    for bad in (0, 9, -1, 2**40, "1e1", "auto "):
+        r = post_bytes(f"{srv.url}/v1/exemplars", small.read_bytes(), params={**other, "levels": bad})
+        assert_error(r, 400, "invalid_argument", "levels")
+    alive(srv)
+
+
 def test_an_empty_timeout_is_an_error_not_the_default(srv):
     # `?timeout=` is not a number (found by the contract fuzzer): 400 naming timeout
     vid = create_volume(srv).json()["id"]
