@@ -523,10 +523,9 @@ HttpResponse Api::cut(const HttpRequest& r) {
     SOLIDTEX_RETURN_IF_ERROR(volumes_.check_target_size(w * h, "size"));
     SOLIDTEX_ASSIGN_OR_RETURN(const int level, level_of_scale(r, q));
     std::optional<VoxelSampling> requested;  // auto
-    if (j.contains("resample")) {
-      if (!j["resample"].is_string())
-        return Status(StatusCode::kInvalidArgument, "must be auto, nearest or cubic", "resample");
-      SOLIDTEX_ASSIGN_OR_RETURN(requested, parse_voxel_sampling(j["resample"].get<std::string>(), "resample"));
+    if (j.contains("resample")) {  // a non-string is no name: parse_voxel_sampling's error
+      const std::string name = j["resample"].is_string() ? j["resample"].get<std::string>() : std::string();
+      SOLIDTEX_ASSIGN_OR_RETURN(requested, parse_voxel_sampling(name, "resample"));
     }
     SOLIDTEX_ASSIGN_OR_RETURN(const VoxelSampling preferred, auto_sampling(r, requested));
     SOLIDTEX_ASSIGN_OR_RETURN(TargetSet target, TargetSet::plane_cut(origin, u, v, int(w), int(h), requested, preferred));
