@@ -22,6 +22,8 @@
 #   CLUSTER_BALANCE   hash (consistent hashing on the affinity key) or round-robin
 #   CLUSTER_NGINX_CACHE  on, or off to measure the replicas without nginx's cache
 #   CLUSTER_SERVE_FLAGS  extra `solidtex serve` flags for every replica (e.g. "--threads 1")
+#   CLUSTER_RESTART_DELAY  seconds the supervisor waits before restarting a dead nginx or S3
+#                     server (1; the cluster test lengthens the outage it causes)
 #   SOLIDTEX_BIN      the solidtex executable (build/bin/solidtex)
 #
 # When everything answers, CLUSTER_DIR/cluster.json describes the running cluster (urls, pids,
@@ -36,6 +38,7 @@ port=${CLUSTER_PORT:-8090}
 replicas=${CLUSTER_REPLICAS:-3}
 balance=${CLUSTER_BALANCE:-hash}
 nginx_cache=${CLUSTER_NGINX_CACHE:-on}
+restart_delay=${CLUSTER_RESTART_DELAY:-1}
 bin=${SOLIDTEX_BIN:-$root/build/bin/solidtex}
 host=127.0.0.1
 s3_port=$((port + 20))
@@ -133,6 +136,73 @@ stop_all() {
   rm -f "$dir/cluster.json"
 }
 
+# nginx and the S3 server are supervised as a container runtime would (deploy/k8s restarts a
+# crashed pod): when either dies it is started again, so killing one (the cluster test does,
+# with kill -9) is an outage, not the end of the cluster. Replicas are not: the cluster test
+# kills and restarts them itself, to watch the balancer route around a dead one.
+store_pid="" nginx_pid="" store_kind="" store_key="" store_secret="" env_json="{}" replicas_json=""
+
+start_store() {  # versitygw on $s3_port serving $dir/s3; sets store_pid
+  ROOT_ACCESS_KEY=$store_key ROOT_SECRET_KEY=$store_secret VERSITYGW_BUCKET=$s3_bucket \
+    "$root/scripts/versitygw.sh" run "$s3_port" "$dir/s3" >>"$dir/logs/s3.log" 2>&1 &
+  store_pid=$!
+  store_kind=s3
+  pids+=("$store_pid")
+  local end=$((SECONDS + 30))
+  until curl -s -o /dev/null --max-time 2 "http://$host:$s3_port/"; do
+    kill -0 "$store_pid" 2>/dev/null || { echo "cluster: the S3 server exited (see $dir/logs/s3.log)" >&2; return 1; }
+    [ $SECONDS -lt $end ] || { echo "cluster: the S3 server did not answer" >&2; return 1; }
+    sleep 0.1
+  done
+}
+
+start_nginx() {  # nginx in the foreground (daemon off), leading its own process group; sets nginx_pid
+  setsid "$(nginx_bin)" -p "$dir/nginx" -c "$dir/nginx/nginx.conf" &
+  nginx_pid=$!
+  pids+=("$nginx_pid")
+  wait_http "http://$host:$port/lb-healthz" 30 "$nginx_pid" "nginx (see $dir/nginx/error.log)"
+}
+
+write_state() {  # CLUSTER_DIR/cluster.json, replaced whole (pids change on restarts)
+  local store_json
+  if [ "$store_kind" = s3 ]; then
+    store_json="{\"kind\": \"s3\", \"endpoint\": \"http://$host:$s3_port\", \"bucket\": \"$s3_bucket\", \"prefix\": \"$s3_prefix\", \"dir\": \"$dir/s3\", \"pid\": $store_pid}"
+  else
+    store_json="{\"kind\": \"dir\", \"data\": \"$dir/data\"}"
+  fi
+  cat >"$dir/cluster.json.tmp" <<STATE
+{"url": "http://$host:$port", "pid": $$, "balance": "$balance", "dir": "$dir",
+ "nginx": {"pid": $nginx_pid, "port": $port, "conf": "$dir/nginx/nginx.conf", "access_log": "$dir/nginx/access.log", "error_log": "$dir/nginx/error.log"},
+ "storage": $store_json, "env": $env_json,
+ "replicas": [$replicas_json]}
+STATE
+  mv "$dir/cluster.json.tmp" "$dir/cluster.json"
+}
+
+# Serves until a signal arrives, restarting nginx and the S3 server when they die. A killed
+# nginx master leaves its workers holding the port; its process group goes before the restart.
+supervise() {
+  while true; do
+    sleep 0.2 &
+    wait $! || true
+    local restarted=""
+    if [ "$store_kind" = s3 ] && ! kill -0 "$store_pid" 2>/dev/null; then
+      echo "cluster: the S3 server (pid $store_pid) died; starting it again in $restart_delay s" >&2
+      sleep "$restart_delay"
+      start_store || { echo "cluster: the S3 server did not come back; stopping" >&2; exit 1; }
+      restarted=1
+    fi
+    if ! kill -0 "$nginx_pid" 2>/dev/null; then
+      echo "cluster: nginx (pid $nginx_pid) died; starting it again in $restart_delay s" >&2
+      kill -KILL -- "-$nginx_pid" 2>/dev/null || true
+      sleep "$restart_delay"
+      start_nginx || { echo "cluster: nginx did not come back; stopping" >&2; exit 1; }
+      restarted=1
+    fi
+    [ -z "$restarted" ] || write_state
+  done
+}
+
 up() {
   install_nginx
   [ -x "$bin" ] || { echo "cluster: $bin not found (make build)" >&2; exit 1; }
@@ -144,30 +214,22 @@ up() {
   trap 'echo; echo "cluster: stopping"; exit 0' INT TERM
 
   # ---- storage ----
-  local store_flags=() env_json="{}" store_json
+  local store_flags=() env_json="{}"
   case "$storage" in
     dir)
       store_flags=(--data "$dir/data")
-      store_json="{\"kind\": \"dir\", \"data\": \"$dir/data\"}" ;;
+      store_kind=dir ;;
     s3)
       local key=solidtex secret=solidtex-secret
       # Go's official tarball installs to /usr/local/go; a non-login shell may not have it on PATH.
       command -v go >/dev/null || { [ -x /usr/local/go/bin/go ] && export PATH=/usr/local/go/bin:$PATH; } || true
       "$root/scripts/versitygw.sh" build >/dev/null ||
         { echo "cluster: cannot build versitygw (the S3 server); CLUSTER_STORAGE=dir runs without it" >&2; exit 1; }
-      ROOT_ACCESS_KEY=$key ROOT_SECRET_KEY=$secret VERSITYGW_BUCKET=$s3_bucket \
-        "$root/scripts/versitygw.sh" run "$s3_port" "$dir/s3" >"$dir/logs/s3.log" 2>&1 &
-      pids+=($!)
-      local end=$((SECONDS + 30))
-      until curl -s -o /dev/null --max-time 2 "http://$host:$s3_port/"; do
-        kill -0 "${pids[-1]}" 2>/dev/null || { echo "cluster: the S3 server exited (see $dir/logs/s3.log)" >&2; exit 1; }
-        [ $SECONDS -lt $end ] || { echo "cluster: the S3 server did not answer" >&2; exit 1; }
-        sleep 0.1
-      done
+      store_key=$key store_secret=$secret
+      start_store || exit 1
       export AWS_ACCESS_KEY_ID=$key AWS_SECRET_ACCESS_KEY=$secret AWS_REGION=us-east-1
       store_flags=(--storage "s3://$s3_bucket/$s3_prefix" --s3-endpoint "http://$host:$s3_port")
-      env_json="{\"AWS_ACCESS_KEY_ID\": \"$key\", \"AWS_SECRET_ACCESS_KEY\": \"$secret\", \"AWS_REGION\": \"us-east-1\"}"
-      store_json="{\"kind\": \"s3\", \"endpoint\": \"http://$host:$s3_port\", \"bucket\": \"$s3_bucket\", \"prefix\": \"$s3_prefix\", \"dir\": \"$dir/s3\", \"pid\": ${pids[-1]}}" ;;
+      env_json="{\"AWS_ACCESS_KEY_ID\": \"$key\", \"AWS_SECRET_ACCESS_KEY\": \"$secret\", \"AWS_REGION\": \"us-east-1\"}" ;;
     *) echo "cluster: CLUSTER_STORAGE must be dir or s3" >&2; exit 2 ;;
   esac
 
@@ -187,36 +249,19 @@ up() {
 
   # ---- nginx ----
   render_local "$dir/nginx/nginx.conf"
-  local nginx
-  nginx=$(nginx_bin)
-  "$nginx" -p "$dir/nginx" -c "$dir/nginx/nginx.conf" -t -q
-  "$nginx" -p "$dir/nginx" -c "$dir/nginx/nginx.conf" &
-  pids+=($!)
-  local nginx_pid=${pids[-1]}
-  wait_http "http://$host:$port/lb-healthz" 30 "$nginx_pid" "nginx (see $dir/nginx/error.log)"
+  "$(nginx_bin)" -p "$dir/nginx" -c "$dir/nginx/nginx.conf" -t -q
+  start_nginx || exit 1
   wait_http "http://$host:$port/healthz" 30 "$nginx_pid" "nginx's upstream"
-
-  cat >"$dir/cluster.json.tmp" <<EOF
-{"url": "http://$host:$port", "pid": $$, "balance": "$balance", "dir": "$dir",
- "nginx": {"pid": $nginx_pid, "port": $port, "conf": "$dir/nginx/nginx.conf", "access_log": "$dir/nginx/access.log", "error_log": "$dir/nginx/error.log"},
- "storage": $store_json, "env": $env_json,
- "replicas": [$replicas_json]}
-EOF
-  mv "$dir/cluster.json.tmp" "$dir/cluster.json"
+  write_state
   cat <<MSG
 
 solidtex cluster: $replicas replicas behind nginx ($balance), storage: $storage
   $(printf 'http://%s:%s' "$host" "$port")            <- use this URL (browser app, API)
   replicas: $(for i in $(seq 1 "$replicas"); do printf 'http://%s:%s ' "$host" "$((port + i))"; done)
   logs: $dir/logs, $dir/nginx/access.log; state: $dir/cluster.json
-Ctrl-C stops the cluster.
+Ctrl-C stops the cluster; nginx and the S3 server are restarted if they die.
 MSG
-  # Serves until nginx ends or a signal arrives; a replica that dies (kill -9 in the cluster
-  # test) leaves the others and nginx running.
-  local rc=0
-  wait "$nginx_pid" || rc=$?
-  echo "cluster: nginx exited (status $rc); stopping" >&2
-  exit "$rc"
+  supervise
 }
 
 case "${1:-up}" in

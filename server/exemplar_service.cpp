@@ -67,6 +67,14 @@ std::string host_name() {
 // process died twice (a poison pill) is marked failed instead of crash-looping the server.
 constexpr int kMaxAnalysisAttempts = 2;
 
+// How long an analysis job keeps retrying a store that cannot be reached (an S3 server
+// restarting) before it fails: an acknowledged upload outlives a short outage.
+constexpr auto kStoreOutageTolerance = std::chrono::seconds(120);
+
+const Status& status_of(const Status& s) { return s; }
+template <typename T>
+const Status& status_of(const Result<T>& r) { return r.status(); }
+
 }  // namespace
 
 struct ExemplarService::Impl {
@@ -400,6 +408,34 @@ struct ExemplarService::Impl {
     }
   }
 
+  bool interrupted(const std::string& id) {
+    std::lock_guard<std::mutex> g(mutex);
+    auto it = entries.find(id);
+    return stopping.load() || it == entries.end() || it->second.cancel;
+  }
+
+  // `op` (a store read or write of job `id`), retried with backoff while the store answers
+  // "unavailable" (kResourceExhausted), for up to kStoreOutageTolerance or until the job is
+  // cancelled or the server stops. Other errors, and success, return at once.
+  template <typename Op>
+  auto through_outages(const std::string& id, Op&& op) -> decltype(op()) {
+    const auto give_up = std::chrono::steady_clock::now() + kStoreOutageTolerance;
+    auto backoff = std::chrono::milliseconds(250);
+    for (bool logged = false;; backoff = std::min(backoff * 2, std::chrono::milliseconds(4000))) {
+      auto r = op();
+      const Status& st = status_of(r);
+      if (st.code() != StatusCode::kResourceExhausted || std::chrono::steady_clock::now() + backoff > give_up) return r;
+      if (!logged) {
+        std::cerr << "analysis of exemplar " << id << ": " << st.message() << "; retrying until the store is back\n";
+        logged = true;
+      }
+      for (auto slept = std::chrono::milliseconds(0); slept < backoff; slept += std::chrono::milliseconds(50)) {
+        if (interrupted(id)) return r;
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      }
+    }
+  }
+
   // `attempt` was made durable (worker) before the job showed as running.
   void run_analysis(const std::string& id, int attempt) {
     json meta;
@@ -411,7 +447,9 @@ struct ExemplarService::Impl {
     auto result = [&]() -> Result<json> {
       std::vector<std::pair<std::string, std::vector<uint8_t>>> parts;
       for (const auto& name : meta["parts"]) {
-        SOLIDTEX_ASSIGN_OR_RETURN(auto bytes, store.read(ResourceKind::kExemplar, id, name.get<std::string>() + ".img"));
+        SOLIDTEX_ASSIGN_OR_RETURN(auto bytes, through_outages(id, [&] {
+                                    return store.read(ResourceKind::kExemplar, id, name.get<std::string>() + ".img");
+                                  }));
         parts.emplace_back(name.get<std::string>(), std::move(bytes));
       }
       SOLIDTEX_ASSIGN_OR_RETURN(AnalysisParams params, analysis_params_from_json(meta["params"], "params"));
@@ -423,7 +461,7 @@ struct ExemplarService::Impl {
       interrupter.stage(75, 100);
       SOLIDTEX_ASSIGN_OR_RETURN(r.table, balance_usage(r.table, {}, interrupter));
       const std::vector<uint8_t> bytes = encode_table(*r.table);
-      SOLIDTEX_RETURN_IF_ERROR(store.write(ResourceKind::kExemplar, id, "table.stx", bytes));
+      SOLIDTEX_RETURN_IF_ERROR(through_outages(id, [&] { return store.write(ResourceKind::kExemplar, id, "table.stx", bytes); }));
       return json{{"levels", to_json(r.levels)}, {"table_bytes", int64_t(bytes.size())},
                   {"seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()}};
     }();
@@ -439,7 +477,8 @@ struct ExemplarService::Impl {
     }
     json record = result ? *result : json{{"error", status_json(result.status())}, {"seconds", seconds}};
     // An exemplar deleted meanwhile has no directory any more; the write then fails harmlessly.
-    Status st = store.write_text(ResourceKind::kExemplar, id, "result.json", record.dump());
+    const std::string text = record.dump();
+    Status st = through_outages(id, [&] { return store.write_text(ResourceKind::kExemplar, id, "result.json", text); });
     std::lock_guard<std::mutex> g(mutex);
     release(id);  // the result is there: the lease has served
     auto it = entries.find(id);

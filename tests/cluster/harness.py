@@ -41,13 +41,14 @@ class Cluster:
 
     def __init__(self, directory: Path, replicas: int = 3, balance: str = "hash",
                  storage: Optional[str] = None, serve_flags: str = "", nginx_cache: str = "on",
-                 timeout: float = 600) -> None:
+                 restart_delay: float = 1, timeout: float = 600) -> None:
         self.dir = Path(directory)
         self.dir.mkdir(parents=True, exist_ok=True)
         self.port = free_base_port(replicas)
         env = dict(os.environ, CLUSTER_DIR=str(self.dir), CLUSTER_PORT=str(self.port),
                    CLUSTER_REPLICAS=str(replicas), CLUSTER_BALANCE=balance,
-                   CLUSTER_SERVE_FLAGS=serve_flags, CLUSTER_NGINX_CACHE=nginx_cache)
+                   CLUSTER_SERVE_FLAGS=serve_flags, CLUSTER_NGINX_CACHE=nginx_cache,
+                   CLUSTER_RESTART_DELAY=str(restart_delay))
         if storage:
             env["CLUSTER_STORAGE"] = storage
         state_path = self.dir / "cluster.json"
@@ -118,6 +119,39 @@ class Cluster:
                 pass
             if self.restarted[i].poll() is not None or time.monotonic() > end:
                 raise AssertionError(f"replica {i} did not restart:\n{self.replica_log(i)[-3000:]}")
+            time.sleep(0.05)
+
+    def reload_state(self) -> Dict[str, Any]:
+        """cluster.json as the script last wrote it (its supervisor rewrites it on restarts)."""
+        self.state = json.loads((self.dir / "cluster.json").read_text())
+        return self.state
+
+    def kill_nginx(self) -> int:
+        """kill -9 of nginx, master and workers (its process group); returns the master's pid.
+        The script's supervisor starts it again."""
+        pid = int(self.reload_state()["nginx"]["pid"])
+        os.killpg(pid, signal.SIGKILL)
+        return pid
+
+    def kill_store(self) -> int:
+        """kill -9 of the S3 server; returns its pid. The script's supervisor starts it again."""
+        pid = int(self.reload_state()["storage"]["pid"])
+        os.kill(pid, signal.SIGKILL)
+        return pid
+
+    def wait_restarted(self, what: str, old_pid: int, timeout: float = 60) -> float:
+        """Waits until the supervisor has replaced ``what`` ("nginx" or "storage") whose pid was
+        ``old_pid`` and nginx answers again; returns the time (monotonic) it did."""
+        end = time.monotonic() + timeout
+        while True:
+            try:
+                if int(self.reload_state()[what]["pid"]) != old_pid and \
+                        requests.get(self.url + "/lb-healthz", timeout=2).status_code == 200:
+                    return time.monotonic()
+            except (ValueError, KeyError, OSError, requests.RequestException):
+                pass  # cluster.json is replaced whole, but may be read mid-rename on some filesystems
+            if self.proc.poll() is not None or time.monotonic() > end:
+                raise AssertionError(f"{what} was not restarted:\n{self.script_log()}")
             time.sleep(0.05)
 
     def stop(self) -> None:

@@ -65,7 +65,8 @@ def cluster(tmp_path_factory):
     assert BIN.is_file(), f"{BIN} not found: build it (make build) or set SOLIDTEX_BIN"
     assert shutil.which("nginx") or Path("/usr/sbin/nginx").exists(), \
         "nginx is not installed: scripts/cluster.sh deps (make cluster-test runs it)"
-    c = Cluster(tmp_path_factory.mktemp("cluster"), replicas=3)
+    # nginx or the S3 server, killed, stays down 2 s before its supervisor restarts it.
+    c = Cluster(tmp_path_factory.mktemp("cluster"), replicas=3, restart_delay=2)
     yield c
     c.stop()
 
@@ -325,3 +326,86 @@ def test_kill_9_of_a_replica_under_load_loses_no_acknowledged_object(cluster, vo
     cuts = {requests.get(f"{u}/v1/volumes/{vol}/slice?axis=y&at=2&size=16,16", timeout=T).content
             for u in cluster.replica_urls}
     assert len(cuts) == 1
+
+
+def test_kill_9_of_the_store_or_of_nginx_loses_no_acknowledged_object(cluster, volume):
+    """Issue #16's first target for the two other processes: the S3 server, then nginx, killed
+    with -9 under load and restarted by scripts/cluster.sh's supervisor."""
+    v = f"{cluster.url}/v1/volumes/{volume['id']}"
+    cached = f"{v}/slice?axis=z&at=1&size=24,24"
+    before = requests.get(cached, timeout=T)
+    assert before.status_code == 200
+    kills: Dict[str, tuple] = {}
+    load = Load(cluster.url, volume)
+    try:
+        time.sleep(2)
+        if cluster.state["storage"]["kind"] == "s3":
+            t = time.monotonic()
+            kills["storage"] = (t, cluster.wait_restarted("storage", cluster.kill_store()))
+            time.sleep(5)
+        t = time.monotonic()
+        kills["nginx"] = (t, cluster.wait_restarted("nginx", cluster.kill_nginx()))
+        time.sleep(4)
+    finally:
+        load.finish()
+    records = load.records
+    after_all = max(t_back for _, t_back in kills.values())
+
+    def excused(x) -> bool:
+        start, end, _, status, _ = x
+        if "storage" in kills:  # writes, and reads of volumes a replica had not loaded: 503
+            t_kill, t_back = kills["storage"]
+            if status == 503 and end >= t_kill and start <= t_back + 0.5:
+                return True
+        t_kill, t_back = kills["nginx"]  # nothing listens: connections refused or cut
+        return isinstance(status, str) and end >= t_kill and start <= t_back + 0.5
+
+    bad = [x for x in records if not isinstance(x[3], int) or x[3] >= 500]
+    beyond = [x for x in bad if not excused(x)]
+    assert not beyond, ("failures beyond the outages", {k: v for k, v in kills.items()}, beyond[:10])
+    later = [x for x in records if x[0] > after_all + 0.5]
+    assert len(later) >= 10 and all(isinstance(x[3], int) and x[3] < 500 for x in later)
+    print(f"{len(records)} requests; outages (s): "
+          + ", ".join(f"{k} {b - a:.2f}" for k, (a, b) in kills.items())
+          + f"; {sum(1 for x in bad if x[3] == 503)} answered 503, {sum(1 for x in bad if isinstance(x[3], str))} "
+          f"refused or cut; acknowledged: {len(load.acked['volumes'])} volumes, {len(load.acked['meshes'])} meshes")
+    assert load.acked["volumes"] and load.acked["meshes"]
+    for url in [cluster.url] + cluster.replica_urls:
+        for vid in load.acked["volumes"]:
+            assert requests.get(f"{url}/v1/volumes/{vid}", timeout=T).status_code == 200, (url, vid)
+        for mid in load.acked["meshes"]:
+            assert requests.get(f"{url}/v1/meshes/{mid}", timeout=T).status_code == 200, (url, mid)
+    after = requests.get(cached, timeout=T)
+    assert after.status_code == 200 and after.content == before.content
+
+
+def test_an_analysis_ending_while_the_store_is_down_lands_once_it_is_back(cluster, tmp_path):
+    """An acknowledged upload whose table is written while the S3 server is down: the replica
+    keeps trying, and the job succeeds once the supervisor has restarted the store."""
+    if cluster.state["storage"]["kind"] != "s3":
+        pytest.skip("the store is a directory here: there is no storage process to kill")
+    r = upload(cluster.url, exemplar_png(tmp_path, "spots", 64), name="outage")
+    owner = cluster.replica_urls[cluster.replica_of(r.headers["X-Upstream"])]
+    ex_id, job_id = r.json()["exemplar"]["id"], r.json()["job"]["id"]
+    end = time.monotonic() + 60
+    while requests.get(f"{owner}/v1/jobs/{job_id}", timeout=T).json()["state"] == "queued":
+        assert time.monotonic() < end, "the analysis never started"
+        time.sleep(0.01)
+    old = cluster.kill_store()
+    # The analysis ends during the outage (2 s): its table cannot be written then.
+    time.sleep(1.5)
+    # Reading the job touches the store too: a clear 503 meanwhile, not a failed job.
+    during = requests.get(f"{owner}/v1/jobs/{job_id}", timeout=T)
+    assert during.status_code in (200, 503), during.text
+    if during.status_code == 200:
+        assert during.json()["state"] == "running", during.text
+    else:
+        assert "storage unavailable" in during.json()["error"]["message"], during.text
+    cluster.wait_restarted("storage", old)
+    job = wait_job(owner, job_id, 60)
+    assert job["state"] == "succeeded", job
+    assert f"analysis of exemplar {ex_id}: storage unavailable" in \
+        cluster.replica_log(cluster.replica_of(r.headers["X-Upstream"])), "the table was not written during the outage"
+    for url in [cluster.url] + cluster.replica_urls:
+        assert wait_job(url, job_id, 60)["state"] == "succeeded", url
+        assert requests.get(f"{url}/v1/exemplars/{ex_id}", timeout=T).json()["state"] == "ready", url
