@@ -51,9 +51,13 @@ E = {"400": err("Malformed request: bad JSON, unknown key or query parameter, va
      "413": err("Body larger than --max-upload-mb (default 64 MiB); no other request is answered 413."),
      "415": err("Unsupported Content-Type, or an image or mesh format that is not recognised from its bytes."),
      "422": err(LIMITS_422),
-     "429": err("Too many concurrent analysis jobs (--max-jobs)."), "503": err("Worker queue full (see Retry-After), shutting down, or the storage backend (`--storage s3://...`) cannot be reached or refuses service right now; retry later."),
+     "429": err("Too many concurrent analysis jobs (--max-jobs)."),
+     "502": err("The storage backend (`--storage s3://...`) cannot be reached or refuses service right now (code `unavailable`, "
+                "see Retry-After); retry later, from this or any replica."),
+     "503": err("Worker queue full (see Retry-After) or shutting down; retry later, here or on another replica."),
      "504": err("The request's deadline passed; the work was cancelled.")}
-def errs(*codes): return {c: E[c] for c in codes}
+# Every answer that may be 503 touches the store too, so may be 502.
+def errs(*codes): return {c: E[c] for c in sorted(set(codes) | ({"502"} if "503" in codes else set()))}
 # Chunked-array views (server/chunked_arrays.h): every answer carries CORS headers.
 CORS = {"Access-Control-Allow-Origin": {"schema": {"type": "string"}}, "Access-Control-Expose-Headers": {"schema": {"type": "string"}}}
 # Their successful answers are conditional and ranged (server/conditional_get.h): HEAD (as on
@@ -156,7 +160,7 @@ nullable_error = {"description": "null unless failed: {code, message, field} as 
 S = {
  "Error": {"type": "object", "required": ["error"], "properties": {"error": ref("ErrorDetail")}},
  "ErrorDetail": {"type": "object", "required": ["code", "message", "field"], "properties": {
-     "code": {"type": "string", "description": "Machine-readable: invalid_argument, not_found, unsupported, too_large, corrupt, unprocessable, version_mismatch, cancelled, deadline_exceeded, resource_exhausted, rate_limited, already_exists, failed_precondition, method_not_allowed, internal, io."},
+     "code": {"type": "string", "description": "Machine-readable: invalid_argument, not_found, unsupported, too_large, corrupt, unprocessable, version_mismatch, cancelled, deadline_exceeded, resource_exhausted, rate_limited, unavailable, already_exists, failed_precondition, method_not_allowed, internal, io."},
      "message": {"type": "string"}, "field": {"type": "string", "description": "The input the error is about (body, a JSON path, a query parameter); may be empty."}}},
  "Job": {"type": "object", "required": ["id", "kind", "state", "percent"], "properties": {
      "id": {"type": "string"}, "kind": {"type": "string", "enum": ["analysis"]}, "exemplar_id": {"type": "string"},

@@ -32,6 +32,8 @@ HttpResponse HttpResponse::error(const Status& s) {
   HttpResponse r;
   r.status = http_status_for(s.code());
   r.body = error_body(s);
+  // A store outage is usually a restart: worth retrying soon, from any replica.
+  if (s.code() == StatusCode::kUnavailable) r.headers.push_back({"Retry-After", "1"});
   return r;
 }
 

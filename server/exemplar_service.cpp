@@ -216,7 +216,7 @@ struct ExemplarService::Impl {
     auto text = store.read_text(ResourceKind::kExemplar, id, "meta.json");
     auto meta = text ? parse_json_text(*text, "meta.json") : Result<json>(text.status());
     if (!meta) {
-      if (meta.status().code() == StatusCode::kResourceExhausted) return meta.status();  // the store's failure
+      if (meta.status().code() == StatusCode::kUnavailable) return meta.status();  // the store's failure
       if (report) report->push_back("skipped exemplar " + id + ": " + meta.status().to_string());
       return nullptr;
     }
@@ -415,7 +415,7 @@ struct ExemplarService::Impl {
   }
 
   // `op` (a store read or write of job `id`), retried with backoff while the store answers
-  // "unavailable" (kResourceExhausted), for up to kStoreOutageTolerance or until the job is
+  // "unavailable" (kUnavailable), for up to kStoreOutageTolerance or until the job is
   // cancelled or the server stops. Other errors, and success, return at once.
   template <typename Op>
   auto through_outages(const std::string& id, Op&& op) -> decltype(op()) {
@@ -424,7 +424,7 @@ struct ExemplarService::Impl {
     for (bool logged = false;; backoff = std::min(backoff * 2, std::chrono::milliseconds(4000))) {
       auto r = op();
       const Status& st = status_of(r);
-      if (st.code() != StatusCode::kResourceExhausted || std::chrono::steady_clock::now() + backoff > give_up) return r;
+      if (st.code() != StatusCode::kUnavailable || std::chrono::steady_clock::now() + backoff > give_up) return r;
       if (!logged) {
         std::cerr << "analysis of exemplar " << id << ": " << st.message() << "; retrying until the store is back\n";
         logged = true;

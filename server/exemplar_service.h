@@ -25,7 +25,7 @@
 // exemplar or its job (including lists); there is no background scan. A lease's age is
 // measured by the store's clock (S3: the server's; local: the file's mtime against this
 // host's clock), and hosts sharing a store need distinct names. A store that cannot be read
-// answers kResourceExhausted (503) for reads of one exemplar; list() then shows what this
+// answers kUnavailable (502) for reads of one exemplar; list() then shows what this
 // replica knows. Thread-safe.
 #pragma once
 

@@ -227,7 +227,7 @@ struct FieldService::Impl {
     }
     FieldEntry e;
     if (Status st = load_newest(id, e); !st.is_ok()) {
-      if (st.code() == StatusCode::kResourceExhausted) return st;  // the store's failure, not the field's
+      if (st.code() == StatusCode::kUnavailable) return st;  // the store's failure, not the field's
       if (report) report->push_back("skipped field " + id + ": " + st.to_string());
       return nullptr;
     }

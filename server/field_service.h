@@ -9,7 +9,7 @@
 // Reads go through the store (several replicas on one store, README): a field created
 // through another replica is loaded, a revision added through another is taken up at the next
 // access, and a field deleted through another answers 404. A failure of the store is answered
-// as such (kResourceExhausted from S3: 503); list() then shows what this replica knows.
+// as such (kUnavailable from S3: 502); list() then shows what this replica knows.
 // Thread-safe; operations on one field are serialised within one replica, and across replicas
 // by the store: a revision's files are write-once, so of two changes of one field made at once
 // through two replicas the later one fails with kFailedPrecondition naming "revision" (409)

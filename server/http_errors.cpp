@@ -23,6 +23,10 @@ int http_status_for(StatusCode code) {
     case StatusCode::kCancelled:
     case StatusCode::kResourceExhausted: return 503;
     case StatusCode::kDeadlineExceeded: return 504;
+    // The store behind this replica failed, not the replica: 502, which the reference nginx
+    // neither retries on another replica (they share the store) nor counts against this one
+    // (503 counts, and a store outage would mark every replica down: deploy/README.md).
+    case StatusCode::kUnavailable: return 502;
     case StatusCode::kInternal:
     case StatusCode::kIo: return 500;
   }

@@ -55,7 +55,7 @@ struct MeshService::Impl {
     auto text = store.read_text(ResourceKind::kMesh, id, "meta.json");
     auto j = text ? parse_json_text(*text, "meta.json") : Result<json>(text.status());
     if (!j) {
-      if (j.status().code() == StatusCode::kResourceExhausted) return j.status();  // the store's failure
+      if (j.status().code() == StatusCode::kUnavailable) return j.status();  // the store's failure
       if (report) report->push_back("skipped mesh " + id + ": " + j.status().to_string());
       return false;
     }

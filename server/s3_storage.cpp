@@ -183,7 +183,7 @@ struct S3Storage::Impl {
     if (response.too_large)
       return Status(StatusCode::kTooLarge, "s3 object '" + rq.key + "' is larger than " + std::to_string(rq.max_body) + " bytes");
     if (rc != CURLE_OK)
-      return Status(StatusCode::kResourceExhausted, "storage unavailable: cannot reach the S3 endpoint " + params.endpoint +
+      return Status(StatusCode::kUnavailable, "storage unavailable: cannot reach the S3 endpoint " + params.endpoint +
                                                         " (" + method + " " + rq.key + "): " +
                                                         (error[0] ? std::string(error) : curl_easy_strerror(rc)));
     return response;
@@ -194,7 +194,7 @@ struct S3Storage::Impl {
   Result<Response> perform(const Request& rq) const {
     for (int attempt = 0;; ++attempt) {
       auto r = perform_once(rq);
-      const bool transient = r ? r->status >= 500 : r.status().code() == StatusCode::kResourceExhausted;
+      const bool transient = r ? r->status >= 500 : r.status().code() == StatusCode::kUnavailable;
       if (!transient || !rq.idempotent() || attempt == 2) return r;
       std::this_thread::sleep_for(std::chrono::milliseconds(attempt == 0 ? 50 : 200));
     }
@@ -212,18 +212,18 @@ struct S3Storage::Impl {
     const bool credentials = std::find(std::begin(kCredentialCodes), std::end(kCredentialCodes), e.code) !=
                              std::end(kCredentialCodes);
     if (e.code == "RequestTimeTooSkewed")
-      return Status(StatusCode::kResourceExhausted,
+      return Status(StatusCode::kUnavailable,
                     "storage unavailable: " + where() + " says this host's clock is off by more than 15 minutes (" + said + ")");
     if (r.status == 403 || r.status == 401 || credentials)
-      return Status(StatusCode::kResourceExhausted,
+      return Status(StatusCode::kUnavailable,
                     "storage unavailable: " + where() + " refused the credentials (" + said + ", " + what +
                         "): check AWS_ACCESS_KEY_ID, AWS_SECRET_ACCESS_KEY and AWS_REGION");
     if (e.code == "NoSuchBucket")
-      return Status(StatusCode::kResourceExhausted,
+      return Status(StatusCode::kUnavailable,
                     "storage unavailable: bucket '" + params.bucket + "' does not exist at " + params.endpoint);
     if (r.status == 404) return Status(StatusCode::kNotFound, "no object '" + rq.key + "' in " + where());
     if (r.status >= 500 || r.status == 429)
-      return Status(StatusCode::kResourceExhausted, "storage unavailable: " + where() + " answered " + said + " (" + what + ")");
+      return Status(StatusCode::kUnavailable, "storage unavailable: " + where() + " answered " + said + " (" + what + ")");
     return Status(StatusCode::kInternal, where() + " refused " + what + ": " + said);
   }
 

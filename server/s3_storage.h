@@ -19,7 +19,7 @@
 // leftover rule of open()) are measured by the server's clock: its Date header minus the
 // object's Last-Modified, so replicas' clocks do not enter them.
 // Failures: an unreachable endpoint, a timeout, 5xx, or a refusal of the credentials (403)
-// are kResourceExhausted, naming the endpoint and what went wrong (503 to clients); other
+// are kUnavailable, naming the endpoint and what went wrong (502 to clients); other
 // unexpected answers are kInternal. Idempotent requests (GET, HEAD, LIST, unconditional PUT
 // and DELETE) are retried twice after a transport error or a 5xx; conditional ones are not
 // (a retry of a request that did succeed would report a lost race).

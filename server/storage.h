@@ -17,8 +17,8 @@
 //   calls with the same etag at most one succeeds. An etag names one written content of an
 //   object (a content hash), and is what those calls compare.
 // - Errors are values. kNotFound: no such object. kAlreadyExists / kFailedPrecondition: a
-//   condition did not hold (the race was lost). kResourceExhausted: the store cannot be
-//   reached or refuses service right now (answered 503, "retry later", by http_errors.cpp).
+//   condition did not hold (the race was lost). kUnavailable: the store cannot be
+//   reached or refuses service right now (answered 502, "retry later", by http_errors.cpp).
 //   Other codes (kIo, kInternal, kTooLarge) are failures of this request.
 // Implementations are thread-safe.
 #pragma once

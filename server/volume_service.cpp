@@ -482,15 +482,23 @@ struct VolumeService::Impl {
   }
 
   // The volume, read through the store (several replicas on one data directory): one created
-  // through another replica is loaded, one deleted through another is dropped (404). A failure
-  // of the store is returned as such, changing nothing.
+  // through another replica is loaded, one deleted through another is dropped (404). A store
+  // that cannot be reached changes nothing: a volume this replica has loaded is served as it
+  // knows it (its voxels are a pure function of what it holds; at worst one deleted elsewhere
+  // answers until the store is back), any other answers the store's failure (502).
   // `listed`: a listing just showed it acknowledged.
   Result<std::shared_ptr<Volume>> find(const std::string& id, bool listed = false) {
     auto missing = [&] { return Status(StatusCode::kNotFound, "no volume '" + id + "'", "id"); };
     if (!Storage::valid_id(id)) return missing();
     bool acknowledged = listed;
     if (!acknowledged) {
-      SOLIDTEX_ASSIGN_OR_RETURN(acknowledged, store.acknowledged(ResourceKind::kVolume, id));
+      Result<bool> stored = store.acknowledged(ResourceKind::kVolume, id);
+      if (!stored && stored.status().code() == StatusCode::kUnavailable) {
+        std::lock_guard<std::mutex> g(mutex);
+        auto it = volumes.find(id);
+        if (it != volumes.end()) return it->second;
+      }
+      SOLIDTEX_ASSIGN_OR_RETURN(acknowledged, std::move(stored));
     }
     std::shared_ptr<VolumeState> dropped;
     {
@@ -508,7 +516,7 @@ struct VolumeService::Impl {
     }
     if (!acknowledged) return missing();
     auto v = load_stored(id);
-    if (!v && v.status().code() == StatusCode::kResourceExhausted) return v.status();  // the store's failure
+    if (!v && v.status().code() == StatusCode::kUnavailable) return v.status();  // the store's failure
     if (!v) {
       std::cerr << "solidtex serve: skipped volume " << id << ": " << v.status().to_string() << "\n";
       return missing();
@@ -604,7 +612,7 @@ Status VolumeService::start(std::vector<std::string>* report) {
   SOLIDTEX_ASSIGN_OR_RETURN(std::vector<std::string> ids, impl_->store.ids(ResourceKind::kVolume));
   for (const std::string& id : ids) {
     auto v = impl_->load_stored(id);
-    if (!v && v.status().code() == StatusCode::kResourceExhausted) return v.status();
+    if (!v && v.status().code() == StatusCode::kUnavailable) return v.status();
     if (!v) {
       if (report) report->push_back("skipped volume " + id + ": " + v.status().to_string());
       continue;

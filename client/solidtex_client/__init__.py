@@ -18,7 +18,7 @@ from .client import Client, encode_png, image_bytes
 from .mesh import (ColoredMesh, PlyFormatError, TriangleMesh, mesh_bytes, parse_colored_ply,
                    parse_mesh_ply)
 from .errors import (BadRequest, Conflict, DeadlineExceeded, JobFailed, MethodNotAllowed,
-                     NotFound, PayloadTooLarge, ServiceUnavailable, SolidtexError,
+                     NotFound, PayloadTooLarge, ServiceUnavailable, SolidtexError, StorageUnavailable,
                      TooManyRequests, Unprocessable, UnsupportedMediaType,
                      error_from_response)
 
@@ -28,6 +28,6 @@ __all__ = [
     "parse_mesh_ply",
     "SolidtexError", "BadRequest", "NotFound", "MethodNotAllowed", "Conflict",
     "PayloadTooLarge", "UnsupportedMediaType", "Unprocessable", "TooManyRequests",
-    "ServiceUnavailable", "DeadlineExceeded", "JobFailed", "error_from_response",
+    "ServiceUnavailable", "StorageUnavailable", "DeadlineExceeded", "JobFailed", "error_from_response",
 ]
 __version__ = "1.0.0"

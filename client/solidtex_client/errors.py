@@ -80,6 +80,11 @@ class ServiceUnavailable(SolidtexError):
         super().__init__(status, code, message, field, response)
 
 
+class StorageUnavailable(ServiceUnavailable):
+    """502: the server's storage backend cannot be reached right now (code ``unavailable``);
+    ``retry_after`` in seconds (or ``None``). A ServiceUnavailable, so one handler retries both."""
+
+
 class DeadlineExceeded(SolidtexError):
     """504: the request's deadline passed and its work was cancelled."""
 
@@ -106,6 +111,7 @@ _BY_STATUS: Dict[int, Type[SolidtexError]] = {
     415: UnsupportedMediaType,
     422: Unprocessable,
     429: TooManyRequests,
+    502: StorageUnavailable,
     503: ServiceUnavailable,
     504: DeadlineExceeded,
 }
@@ -149,7 +155,7 @@ def error_from_response(response: Any) -> SolidtexError:
     except ValueError:
         message = response.text[:500] if response.text else (getattr(response, "reason", "") or "")
     cls = _BY_STATUS.get(status, SolidtexError)
-    if cls is ServiceUnavailable:
-        return ServiceUnavailable(status, code, message, field, response,
-                                  retry_after=parse_retry_after(response.headers.get("Retry-After")))
+    if issubclass(cls, ServiceUnavailable):
+        return cls(status, code, message, field, response,
+                   retry_after=parse_retry_after(response.headers.get("Retry-After")))
     return cls(status, code, message, field, response)

@@ -18,6 +18,7 @@ const char* status_code_name(StatusCode code) {
     case StatusCode::kFailedPrecondition: return "failed_precondition";
     case StatusCode::kUnprocessable: return "unprocessable";
     case StatusCode::kRateLimited: return "rate_limited";
+    case StatusCode::kUnavailable: return "unavailable";
     case StatusCode::kInternal: return "internal";
     case StatusCode::kIo: return "io";
   }

@@ -25,6 +25,7 @@ enum class StatusCode {
   kFailedPrecondition, // the target is not in a state that allows this (in use, not ready)
   kUnprocessable,      // well-formed input whose content cannot be used (e.g. image too big in pixels)
   kRateLimited,        // too many concurrent operations of this kind for now; retry later
+  kUnavailable,        // a service this one depends on (the store) cannot be reached or refuses service now
   kInternal,
   kIo,                 // the operating system refused a read or write
 };

@@ -65,8 +65,9 @@ def cluster(tmp_path_factory):
     assert BIN.is_file(), f"{BIN} not found: build it (make build) or set SOLIDTEX_BIN"
     assert shutil.which("nginx") or Path("/usr/sbin/nginx").exists(), \
         "nginx is not installed: scripts/cluster.sh deps (make cluster-test runs it)"
-    # nginx or the S3 server, killed, stays down 2 s before its supervisor restarts it.
-    c = Cluster(tmp_path_factory.mktemp("cluster"), replicas=3, restart_delay=2)
+    # nginx or the S3 server, killed, stays down 4 s before its supervisor restarts it: long
+    # enough for a balancer that counted the store's failures against replicas to drop them all.
+    c = Cluster(tmp_path_factory.mktemp("cluster"), replicas=3, restart_delay=4)
     yield c
     c.stop()
 
@@ -330,7 +331,9 @@ def test_kill_9_of_a_replica_under_load_loses_no_acknowledged_object(cluster, vo
 
 def test_kill_9_of_the_store_or_of_nginx_loses_no_acknowledged_object(cluster, volume):
     """Issue #16's first target for the two other processes: the S3 server, then nginx, killed
-    with -9 under load and restarted by scripts/cluster.sh's supervisor."""
+    with -9 under load and restarted by scripts/cluster.sh's supervisor. While the store is
+    down, what needs it answers 502 and the rest goes on: nginx does not count those 502s
+    against the replicas, so cuts of loaded volumes keep being served."""
     v = f"{cluster.url}/v1/volumes/{volume['id']}"
     cached = f"{v}/slice?axis=z&at=1&size=24,24"
     before = requests.get(cached, timeout=T)
@@ -353,21 +356,25 @@ def test_kill_9_of_the_store_or_of_nginx_loses_no_acknowledged_object(cluster, v
 
     def excused(x) -> bool:
         start, end, _, status, _ = x
-        if "storage" in kills:  # writes, and reads of volumes a replica had not loaded: 503
+        if "storage" in kills:  # writes, and reads of volumes a replica had not loaded: 502
             t_kill, t_back = kills["storage"]
-            if status == 503 and end >= t_kill and start <= t_back + 0.5:
+            if status == 502 and end >= t_kill and start <= t_back + 0.5:
                 return True
         t_kill, t_back = kills["nginx"]  # nothing listens: connections refused or cut
         return isinstance(status, str) and end >= t_kill and start <= t_back + 0.5
 
     bad = [x for x in records if not isinstance(x[3], int) or x[3] >= 500]
     beyond = [x for x in bad if not excused(x)]
+    if "storage" in kills:  # cuts of the loaded volume went on while the store was down
+        t_kill, t_back = kills["storage"]
+        served = [x for x in records if x[2] == "new" and x[3] == 200 and x[0] > t_kill + 0.5 and x[1] < t_back]
+        assert len(served) >= 5, f"only {len(served)} new cuts served during the store's outage"
     assert not beyond, ("failures beyond the outages", {k: v for k, v in kills.items()}, beyond[:10])
     later = [x for x in records if x[0] > after_all + 0.5]
     assert len(later) >= 10 and all(isinstance(x[3], int) and x[3] < 500 for x in later)
     print(f"{len(records)} requests; outages (s): "
           + ", ".join(f"{k} {b - a:.2f}" for k, (a, b) in kills.items())
-          + f"; {sum(1 for x in bad if x[3] == 503)} answered 503, {sum(1 for x in bad if isinstance(x[3], str))} "
+          + f"; {sum(1 for x in bad if x[3] == 502)} answered 502, {sum(1 for x in bad if isinstance(x[3], str))} "
           f"refused or cut; acknowledged: {len(load.acked['volumes'])} volumes, {len(load.acked['meshes'])} meshes")
     assert load.acked["volumes"] and load.acked["meshes"]
     for url in [cluster.url] + cluster.replica_urls:
@@ -394,9 +401,9 @@ def test_an_analysis_ending_while_the_store_is_down_lands_once_it_is_back(cluste
     old = cluster.kill_store()
     # The analysis ends during the outage (2 s): its table cannot be written then.
     time.sleep(1.5)
-    # Reading the job touches the store too: a clear 503 meanwhile, not a failed job.
+    # Reading the job touches the store too: a clear 502 meanwhile, not a failed job.
     during = requests.get(f"{owner}/v1/jobs/{job_id}", timeout=T)
-    assert during.status_code in (200, 503), during.text
+    assert during.status_code in (200, 502), during.text
     if during.status_code == 200:
         assert during.json()["state"] == "running", during.text
     else:

@@ -11,7 +11,7 @@ from PIL import Image
 
 from support import FakeSession, fake_response  # (support also puts <repo>/client on sys.path)
 from solidtex_client import (BadRequest, Client, Conflict, DeadlineExceeded, JobFailed,
-                             MethodNotAllowed, NotFound, PayloadTooLarge, ServiceUnavailable,
+                             MethodNotAllowed, NotFound, PayloadTooLarge, ServiceUnavailable, StorageUnavailable,
                              SolidtexError, TooManyRequests, Unprocessable, UnsupportedMediaType,
                              encode_png, error_from_response)
 from solidtex_client import cli as cli_module
@@ -63,7 +63,7 @@ def test_encode_png_float_is_16_bit():
 @pytest.mark.parametrize("status,cls", [
     (400, BadRequest), (404, NotFound), (405, MethodNotAllowed), (409, Conflict),
     (413, PayloadTooLarge), (415, UnsupportedMediaType), (422, Unprocessable),
-    (429, TooManyRequests), (503, ServiceUnavailable), (504, DeadlineExceeded)])
+    (429, TooManyRequests), (502, StorageUnavailable), (503, ServiceUnavailable), (504, DeadlineExceeded)])
 def test_error_classes_by_status(status, cls):
     e = error_from_response(fake_response(status, {"error": {"code": "c", "message": "m",
                                                               "field": "f"}}))
@@ -78,6 +78,10 @@ def test_error_details():
                                           {"Retry-After": "3"}))
     assert isinstance(e, ServiceUnavailable) and e.retry_after == 3.0
     assert str(e) == "resource_exhausted: queue full"
+    e = error_from_response(fake_response(502, {"error": {"code": "unavailable",
+                                                          "message": "storage unavailable: cannot reach", "field": ""}},
+                                          {"Retry-After": "1"}))
+    assert isinstance(e, StorageUnavailable) and isinstance(e, ServiceUnavailable) and e.retry_after == 1.0
     e = error_from_response(fake_response(500, b"oops"))
     assert type(e) is SolidtexError and e.code == "http_500" and e.message == "oops"
     e = error_from_response(fake_response(503, b"", {"Retry-After": "soon"}))

@@ -287,7 +287,7 @@ def test_bad_credentials_bucket_or_endpoint_stop_start_up_with_a_clear_error(gat
     assert "--storage" in err, err
 
 
-def test_the_store_going_away_answers_503_and_coming_back_heals(replicas, gateway, tmp_path):
+def test_the_store_going_away_answers_502_and_coming_back_heals(replicas, gateway, tmp_path):
     a = replicas()
     fld = a.client.create_field(SKETCH)
     # Make the bucket unreachable for this replica's requests: stop the gateway's bucket by
@@ -297,7 +297,9 @@ def test_the_store_going_away_answers_503_and_coming_back_heals(replicas, gatewa
     bucket_dir.rename(moved)
     try:
         r = requests.get(f"{a.url}/v1/fields/{fld['id']}", timeout=30)
-        assert r.status_code == 503, (r.status_code, r.text)
+        # 502, not 503: the store failed, not this replica (a balancer must not mark it down).
+        assert r.status_code == 502, (r.status_code, r.text)
+        assert r.json()["error"]["code"] == "unavailable" and r.headers.get("Retry-After") == "1", r.text
         assert "does not exist" in r.json()["error"]["message"], r.text
         # lists still answer, with what the replica knows
         assert fld["id"] in [f["id"] for f in a.client.list_fields()]
