@@ -54,6 +54,14 @@ def wait_job(url: str, job_id: str, seconds: float = 180) -> dict:
         time.sleep(0.1)
 
 
+def wait_started(url: str, job_id: str, seconds: float = 60) -> None:
+    """Polls the replica running a job (its own URL) until the job has left the queue."""
+    end = time.monotonic() + seconds
+    while requests.get(f"{url}/v1/jobs/{job_id}", timeout=T).json()["state"] == "queued":
+        assert time.monotonic() < end, "the analysis never started"
+        time.sleep(0.01)
+
+
 def create_volume(url: str, exemplar_id: str, seed: int) -> str:
     r = requests.post(f"{url}/v1/volumes", json={"exemplar": exemplar_id, "seed": seed}, timeout=T)
     assert r.status_code == 201, r.text
@@ -284,10 +292,7 @@ def test_kill_9_of_a_replica_under_load_loses_no_acknowledged_object(cluster, vo
         victim = cluster.replica_of(r.headers["X-Upstream"])
         victim_addr = r.headers["X-Upstream"]
         ex_id, job_id = r.json()["exemplar"]["id"], r.json()["job"]["id"]
-        end = time.monotonic() + 60
-        while requests.get(f"{cluster.replica_urls[victim]}/v1/jobs/{job_id}", timeout=T).json()["state"] == "queued":
-            assert time.monotonic() < end, "the analysis never started"
-            time.sleep(0.02)
+        wait_started(cluster.replica_urls[victim], job_id)
         t_kill = time.monotonic()
         cluster.kill_replica(victim)
         time.sleep(6)
@@ -394,12 +399,9 @@ def test_an_analysis_ending_while_the_store_is_down_lands_once_it_is_back(cluste
     r = upload(cluster.url, exemplar_png(tmp_path, "spots", 64), name="outage")
     owner = cluster.replica_urls[cluster.replica_of(r.headers["X-Upstream"])]
     ex_id, job_id = r.json()["exemplar"]["id"], r.json()["job"]["id"]
-    end = time.monotonic() + 60
-    while requests.get(f"{owner}/v1/jobs/{job_id}", timeout=T).json()["state"] == "queued":
-        assert time.monotonic() < end, "the analysis never started"
-        time.sleep(0.01)
+    wait_started(owner, job_id)
     old = cluster.kill_store()
-    # The analysis ends during the outage (2 s): its table cannot be written then.
+    # The analysis ends during the outage (4 s): its table cannot be written then.
     time.sleep(1.5)
     # Reading the job touches the store too: a clear 502 meanwhile, not a failed job.
     during = requests.get(f"{owner}/v1/jobs/{job_id}", timeout=T)
