@@ -190,13 +190,17 @@ struct ExemplarService::Impl {
   // exemplar this replica has not seen (uploaded through another replica), drops one whose
   // directory is gone (deleted through another replica), takes up another replica's result,
   // and claims a job nobody works on (adopt_locked). Null: no such exemplar; an error: the
-  // store could not be read (nothing changed). `listed`: a listing just showed it acknowledged.
+  // store could not be read (nothing changed), unless this replica knows the exemplar: then
+  // its entry as this replica knows it (a job running here keeps answering its progress).
+  // `listed`: a listing just showed it acknowledged.
   Result<Entry*> sync_locked(const std::string& id, std::vector<std::string>* report = nullptr, bool listed = false) {
     if (!Storage::valid_id(id)) return nullptr;
     auto it = entries.find(id);
     bool acknowledged = listed;
     if (!acknowledged) {
-      SOLIDTEX_ASSIGN_OR_RETURN(acknowledged, store.acknowledged(ResourceKind::kExemplar, id));
+      Result<bool> stored = store.acknowledged(ResourceKind::kExemplar, id);
+      if (!stored && stored.status().code() == StatusCode::kUnavailable && it != entries.end()) return &it->second;
+      SOLIDTEX_ASSIGN_OR_RETURN(acknowledged, std::move(stored));
     }
     if (it != entries.end()) {
       Entry& e = it->second;

@@ -403,13 +403,9 @@ def test_an_analysis_ending_while_the_store_is_down_lands_once_it_is_back(cluste
     old = cluster.kill_store()
     # The analysis ends during the outage (4 s): its table cannot be written then.
     time.sleep(1.5)
-    # Reading the job touches the store too: a clear 502 meanwhile, not a failed job.
+    # The replica running the job answers its state from memory meanwhile: still running.
     during = requests.get(f"{owner}/v1/jobs/{job_id}", timeout=T)
-    assert during.status_code in (200, 502), during.text
-    if during.status_code == 200:
-        assert during.json()["state"] == "running", during.text
-    else:
-        assert "storage unavailable" in during.json()["error"]["message"], during.text
+    assert during.status_code == 200 and during.json()["state"] == "running", during.text
     cluster.wait_restarted("storage", old)
     job = wait_job(owner, job_id, 60)
     assert job["state"] == "succeeded", job
