@@ -32,8 +32,7 @@ HttpResponse HttpResponse::error(const Status& s) {
   HttpResponse r;
   r.status = http_status_for(s.code());
   r.body = error_body(s);
-  // A store outage is usually a restart: worth retrying soon, from any replica.
-  if (s.code() == StatusCode::kUnavailable) r.headers.push_back({"Retry-After", "1"});
+  if (const char* seconds = retry_after_for(s.code())) r.headers.push_back({"Retry-After", seconds});
   return r;
 }
 

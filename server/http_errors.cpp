@@ -33,6 +33,8 @@ int http_status_for(StatusCode code) {
   return 500;
 }
 
+const char* retry_after_for(StatusCode code) { return code == StatusCode::kUnavailable ? "1" : nullptr; }
+
 std::string error_body(const std::string& code, const std::string& message, const std::string& field) {
   nlohmann::json j = {{"error", {{"code", code}, {"message", message}, {"field", field}}}};
   return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);  // messages may echo client bytes

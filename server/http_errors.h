@@ -9,6 +9,9 @@
 namespace solidtex::server {
 
 int http_status_for(StatusCode code);
+// The Retry-After seconds an error answer carries, or null for none: a store outage (usually
+// a restart) is worth retrying soon, from any replica.
+const char* retry_after_for(StatusCode code);
 // {"error": {"code": "<status_code_name>", "message": ..., "field": ...}}
 std::string error_body(const Status& status);
 // For errors the HTTP layer itself raises (no route, wrong method): explicit code name.
