@@ -195,17 +195,23 @@ struct FieldService::Impl {
   // Read-through (mutex held; several replicas on one data directory): loads a field created
   // through another replica, takes up revisions another replica added (a newer r<N>.json; the
   // live solver, of an older revision, is dropped), and drops a field deleted through another
-  // replica. Null: no such field; an error: the store could not be read (nothing changed).
-  // Changes of one field through two replicas at the same moment are serialised by the store:
-  // revisions are write-once (write_revision), the later change answers 409.
+  // replica. Null: no such field; an error: the store could not be read (nothing changed),
+  // unless this replica knows the field: then its entry at the revision this replica knows
+  // (revisions are write-once, so that one stays valid; a newer one is taken up once the
+  // store answers again). Changes of one field through two replicas at the same moment are
+  // serialised by the store: revisions are write-once (write_revision), the later change
+  // answers 409.
   // `listed`: a listing just showed it acknowledged.
   Result<FieldEntry*> sync_locked(const std::string& id, std::vector<std::string>* report = nullptr,
                                   bool listed = false) {
     if (!Storage::valid_id(id)) return nullptr;
     auto it = entries.find(id);
+    auto unavailable = [](const Status& st) { return st.code() == StatusCode::kUnavailable; };
     bool acknowledged = listed;
     if (!acknowledged) {
-      SOLIDTEX_ASSIGN_OR_RETURN(acknowledged, store.acknowledged(ResourceKind::kField, id));
+      Result<bool> stored = store.acknowledged(ResourceKind::kField, id);
+      if (!stored && unavailable(stored.status()) && it != entries.end()) return &it->second;
+      SOLIDTEX_ASSIGN_OR_RETURN(acknowledged, std::move(stored));
     }
     if (!acknowledged) {
       if (it != entries.end()) entries.erase(it);
@@ -213,7 +219,9 @@ struct FieldService::Impl {
     }
     if (it != entries.end()) {
       FieldEntry& e = it->second;
-      SOLIDTEX_ASSIGN_OR_RETURN(bool has_next, store.exists(ResourceKind::kField, id, json_name(e.revision + 1)));
+      Result<bool> next = store.exists(ResourceKind::kField, id, json_name(e.revision + 1));
+      if (!next && unavailable(next.status())) return &e;
+      SOLIDTEX_ASSIGN_OR_RETURN(bool has_next, std::move(next));
       if (has_next) {  // its .json is written last: the .stf is there too
         FieldEntry newer;
         if (load_newest(id, newer).is_ok() && newer.revision > e.revision) {

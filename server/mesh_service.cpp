@@ -37,14 +37,18 @@ struct MeshService::Impl {
 
   // Read-through (mutex held; several replicas on one data directory): loads a mesh stored
   // through another replica, drops one deleted through another. False: no such mesh; an
-  // error: the store could not be read.
+  // error: the store could not be read, unless this replica knows the mesh: then true, and
+  // it is served as known (meshes are write-once; at worst one deleted elsewhere answers
+  // until the store is back).
   // `listed`: a listing just showed it acknowledged.
   Result<bool> sync_locked(const std::string& id, std::vector<std::string>* report = nullptr, bool listed = false) {
     if (!Storage::valid_id(id)) return false;
     auto it = meta.find(id);
     bool acknowledged = listed;
     if (!acknowledged) {
-      SOLIDTEX_ASSIGN_OR_RETURN(acknowledged, store.acknowledged(ResourceKind::kMesh, id));
+      Result<bool> stored = store.acknowledged(ResourceKind::kMesh, id);
+      if (!stored && stored.status().code() == StatusCode::kUnavailable && it != meta.end()) return true;
+      SOLIDTEX_ASSIGN_OR_RETURN(acknowledged, std::move(stored));
     }
     if (!acknowledged) {
       if (it != meta.end()) meta.erase(it);

@@ -290,19 +290,30 @@ def test_bad_credentials_bucket_or_endpoint_stop_start_up_with_a_clear_error(gat
 def test_the_store_going_away_answers_502_and_coming_back_heals(replicas, gateway, tmp_path):
     a = replicas()
     fld = a.client.create_field(SKETCH)
+    mesh = a.client.upload_mesh(CUBE_OFF, name="cube")
     # Make the bucket unreachable for this replica's requests: stop the gateway's bucket by
     # renaming its directory (versitygw then answers NoSuchBucket), then put it back.
     bucket_dir = gateway["root"] / BUCKET
     moved = gateway["root"] / "moved-away"
     bucket_dir.rename(moved)
     try:
-        r = requests.get(f"{a.url}/v1/fields/{fld['id']}", timeout=30)
-        # 502, not 503: the store failed, not this replica (a balancer must not mark it down).
-        assert r.status_code == 502, (r.status_code, r.text)
-        assert r.json()["error"]["code"] == "unavailable" and r.headers.get("Retry-After") == "1", r.text
-        assert "does not exist" in r.json()["error"]["message"], r.text
-        # lists still answer, with what the replica knows
+        # What the store must confirm answers 502, not 503: the store failed, not this replica
+        # (a balancer must not mark it down): a field this replica has never seen, a write.
+        unknown = "fld_" + "0" * 16 if fld["id"] != "fld_" + "0" * 16 else "fld_" + "1" * 16
+        for r in (requests.get(f"{a.url}/v1/fields/{unknown}", timeout=30),
+                  requests.post(f"{a.url}/v1/fields", json=SKETCH, timeout=30)):
+            assert r.status_code == 502, (r.status_code, r.text)
+            assert r.json()["error"]["code"] == "unavailable" and r.headers.get("Retry-After") == "1", r.text
+            assert "does not exist" in r.json()["error"]["message"], r.text
+        # What this replica knows it answers from memory: the field (and its frames) and the
+        # mesh (and its cleaned triangles); lists too.
+        assert a.client.get_field(fld["id"])["revision"] == 1
+        assert len(a.client.sample_frames(fld["id"], [0, 0, 0], [2, 2, 2], 1.0)["points"]) == 8
+        assert a.client.get_mesh(mesh["id"])["id"] == mesh["id"]
+        assert len(a.client.get_mesh_file(mesh["id"])) > 0
         assert fld["id"] in [f["id"] for f in a.client.list_fields()]
+        assert mesh["id"] in [m["id"] for m in a.client.list_meshes()]
     finally:
         moved.rename(bucket_dir)
     assert a.client.get_field(fld["id"])["revision"] == 1
+    assert a.client.create_field(SKETCH)["revision"] == 1
