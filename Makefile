@@ -40,7 +40,9 @@ clean:
 
 # ---- Cluster (issue #16; deploy/README.md) -------------------------------------------------
 # make cluster: 3 replicas on one store behind nginx on 127.0.0.1:CLUSTER_PORT until Ctrl-C.
-# make cluster-test: tests/cluster against such a cluster (not part of make test).
+# make cluster-test: tests/cluster against such a cluster, then the S3 backend's own tests
+# (tests/python/test_s3_storage.py, which make test skips until versitygw is built); not part
+# of make test.
 CLUSTER_PORT ?= 8090
 .PHONY: cluster cluster-test
 cluster: build
@@ -49,6 +51,8 @@ cluster: build
 cluster-test: build python
 	@scripts/cluster.sh deps
 	@SOLIDTEX_BIN=$(abspath $(BUILD_DIR))/bin/solidtex $(BUILD_DIR)/venv/bin/python -m pytest -q -p no:cacheprovider tests/cluster
+	@scripts/versitygw.sh build >/dev/null
+	@SOLIDTEX_BIN=$(abspath $(BUILD_DIR))/bin/solidtex $(BUILD_DIR)/venv/bin/python -m pytest -q -p no:cacheprovider tests/python/test_s3_storage.py
 
 # ---- Fuzzing and sanitizers -----------------------------------------------------------------
 # The fuzz tree: clang 14, every target instrumented for libFuzzer with ASan and UBSan
