@@ -107,7 +107,7 @@ Status run_analyze(const std::vector<std::string>& argv) {
     j["channels"] = exemplars.channels();
     // What its oblique cuts' resample auto will be (synthesis/voxel_sampling.h).
     j["fine_detail_share"] = fine_detail_share(*result.table);
-    j["cut_resample"] = voxel_sampling_name(preferred_voxel_sampling(*result.table));
+    j["cut_resample"] = voxel_sampling_name(preferred_voxel_sampling(*result.table, SynthesisParams{}.color));
     nlohmann::json levels = nlohmann::json::array();
     for (const LevelReport& r : result.levels)
       levels.push_back({{"level", r.level},

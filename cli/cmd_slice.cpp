@@ -35,7 +35,8 @@ nlohmann::json stats_json(const SynthesisStats& s) {
           {"dependency_seconds", s.dependency_seconds},
           {"corrections_per_second", s.seconds > 0 ? double(s.corrections) / s.seconds : 0.0},
           {"store_bytes", s.store_bytes},
-          {"estimated_bytes", s.estimated_bytes}};
+          {"estimated_bytes", s.estimated_bytes},
+          {"support_voxels", s.support_voxels}};
 }
 
 // The cut the options name, checked before any table loads; built once the tables are known
@@ -155,7 +156,7 @@ Status run_slice(const std::vector<std::string>& argv) {
   }
   // Only a plane cut left to auto needs the tables' preference (it reads their exemplars).
   const VoxelSampling preferred =
-      cut.plane && !cut.resample ? preferred_voxel_sampling(tables) : VoxelSampling::kNearest;
+      cut.plane && !cut.resample ? preferred_voxel_sampling(tables, params.color) : VoxelSampling::kNearest;
   SOLIDTEX_ASSIGN_OR_RETURN(const TargetSet target, build_cut(cut, preferred));
   ProgressBar bar;
   SynthesisStats stats;

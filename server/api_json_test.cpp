@@ -31,7 +31,7 @@ TEST(ApiJson, WireFormatOfTheDefaults) {
             R"({"candidates":12,"knn_checks":192,"levels":0,"neighborhood":9,"pca_dims":20,"search_k":24,"seed":1,)"
             R"("suggested_plane_weights":[1.0,1.0,1.0]})");
   EXPECT_EQ(to_json(SynthesisParams{}).dump(),
-            R"({"balance":1.0,"cell_size":12,"coarse_passes":3,"color":"medoid","finest_subpass_size":1,"init":"auto","init_subpart":32,"matcher":"paper","passes":1,)"
+            R"({"balance":1.0,"cell_size":12,"coarse_passes":3,"color":"auto","finest_subpass_size":1,"init":"auto","init_subpart":32,"matcher":"paper","passes":1,)"
             R"("plane_weights":[1.0,1.0,1.0],"scheme":"dual-grid","subpass_size":2,"trilinear_levels":2,"typicality":0.5})");
 }
 

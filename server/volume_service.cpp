@@ -98,8 +98,9 @@ struct Volume {
 json stats_json(const std::string& kind, const TargetSet& target, const std::vector<SynthesisStats>& per_region,
                 double seconds) {
   json levels = json::array();
-  int64_t voxels = 0, corrections = 0, store_bytes = 0, estimated_bytes = 0;
+  int64_t voxels = 0, corrections = 0, store_bytes = 0, estimated_bytes = 0, support_voxels = 0;
   for (const SynthesisStats& s : per_region) {
+    support_voxels += s.support_voxels;
     store_bytes = std::max(store_bytes, s.store_bytes);
     estimated_bytes = std::max(estimated_bytes, s.estimated_bytes);
   }
@@ -115,6 +116,7 @@ json stats_json(const std::string& kind, const TargetSet& target, const std::vec
       corrections += l.corrections;
     }
   return {{"kind", kind},         {"target_voxels", int64_t(target.voxels.size())},
+          {"support_voxels", support_voxels},
           {"samples", int64_t(target.sample.size())},
           {"voxels", voxels},     {"corrections", corrections},
           {"seconds", seconds},   {"levels", levels},
@@ -292,7 +294,7 @@ struct VolumeService::Impl {
       SOLIDTEX_ASSIGN_OR_RETURN(st->regions, RegionVolume::create(st->synths, label));
       st->synthesizer_bytes += int64_t(sizeof(RegionVolume));
     }
-    st->sampling = solidtex::preferred_voxel_sampling(st->tables);
+    st->sampling = solidtex::preferred_voxel_sampling(st->tables, st->synths.front()->params().color);
     st->field_bytes = field_resident_bytes(*st->field);
     st->surface_bytes = st->surface ? st->surface->resident_bytes() : 0;
     return st;

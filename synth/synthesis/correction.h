@@ -75,6 +75,9 @@ void matching_color(const TableLevel& level, const CoordinateTriple& t, int chan
 // ties go to the lowest plane index, so it is a pure function of (table, triple, weights).
 // `w` are normalised weights (not all zero).
 void output_color(const Table& table, const CoordinateTriple& t, const PlaneWeights& w, ColorRule rule, float rgb[3]);
+// The rule `rule` stands for on `table`: kAuto is kVote for one image shared by the three planes,
+// else kMedoid (a fixed function of the table, like resolved_init). Other rules are themselves.
+ColorRule resolved_color_rule(const Table& table, ColorRule rule);
 
 // Per-level constants of the correction, precomputed once per synthesizer.
 struct CorrectionContext {
@@ -87,7 +90,7 @@ struct CorrectionContext {
   PlaneWeights cost_weights{1.f, 1.f, 1.f};          // per-plane matching weights
   int candidates_per_source = 64;                    // table candidates tried per source pixel
   PlaneWeights color_weights{1.f / 3, 1.f / 3, 1.f / 3};
-  ColorRule color_rule = ColorRule::kMedoid;         // output colors only (finest level)
+  ColorRule color_rule = ColorRule::kMedoid;         // output colors only, resolved (never kAuto)
   float typicality = 0.f;                            // SynthesisParams::typicality
   // Per plane, every exemplar pixel's penalty added to its match cost: typicality times its
   // typicality penalty plus balance times its usage penalty (float ops in that order); null

@@ -62,23 +62,24 @@ Result<std::vector<int>> measure_spread(const std::vector<LevelSchedule>& schedu
 }
 
 RequestCost estimate_cost(const std::vector<LevelSchedule>& schedules, const FrameStencils& stencils,
-                          const std::vector<int>& spread, const TargetSet& target) {
+                          const std::vector<int>& spread, const TargetSet& target, int support_reach) {
   RequestCost cost;
   const int L = stencils.levels();
-  const std::vector<VoxelBox> boxes = dependency_boxes(schedules, stencils, target.bounds(), PyramidLevel{L - 1});
+  const VoxelBox target_box = target.bounds().dilated(support_reach);
+  const std::vector<VoxelBox> boxes = dependency_boxes(schedules, stencils, target_box, PyramidLevel{L - 1});
   cost.levels.resize(size_t(L));
   // Every set voxel of level l lies within `radius` (its own voxels, per axis) of some target
   // voxel's position on that level: the level's spread plus the finer level's radius halved.
   const int64_t targets = int64_t(target.voxels.size());
   int64_t radius = 0;
-  VoxelBox served = target.bounds();
+  VoxelBox served = target_box;
   std::vector<int64_t> store(size_t(L), 0);
   int64_t masks = 0;
   for (int l = L - 1; l >= 0; --l) {
     const LevelSchedule& sch = schedules[size_t(l)];
     const VoxelBox& box = boxes[size_t(l)];
     const VoxelBox set_box = served.dilated(spread[size_t(l)]);
-    radius = (l == L - 1 ? 0 : radius / 2 + 1) + spread[size_t(l)];
+    radius = (l == L - 1 ? support_reach : radius / 2 + 1) + spread[size_t(l)];
     const int64_t side = 2 * radius + 1;
     const int64_t voxels = std::min(box_volume(set_box), sat_mul(targets, sat_mul(side, sat_mul(side, side))));
     const int64_t bricks = std::min(box_bricks(set_box), voxels);

@@ -40,8 +40,10 @@ struct RequestCost {
 Result<std::vector<int>> measure_spread(const std::vector<LevelSchedule>& schedules, const FrameStencils& stencils,
                                         LatchedInterrupter& interrupter);
 
+// `support_reach`: the target level's sets must also serve every voxel within this many voxels
+// (per axis) of a target voxel (the patch vote's support, patch_vote.h), without listing them.
 RequestCost estimate_cost(const std::vector<LevelSchedule>& schedules, const FrameStencils& stencils,
-                          const std::vector<int>& spread, const TargetSet& target);
+                          const std::vector<int>& spread, const TargetSet& target, int support_reach = 0);
 
 // Exact bytes of the level stores the forward pass will allocate for computed sets (the peak
 // of two consecutive levels: a level and its parent are alive together).

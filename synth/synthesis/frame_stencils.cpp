@@ -38,6 +38,7 @@ Result<FrameStencils> FrameStencils::make(const FrameField& field, int neighborh
   // A local offset of at most N/2 on two axes reaches N/2 * sqrt(2) * scale voxels.
   const int base_reach = int(std::ceil((neighborhood / 2) * std::sqrt(2.0) * field.max_scale()));
   if (base_reach + 1 > 120) return Status(StatusCode::kInvalidArgument, "field scales reach too far", "field");
+  f.candidate_reach_ = int(std::ceil(std::sqrt(2.0) * field.max_scale()));
   f.constant_ = field.is_constant();
   if (f.constant_) f.constant_rotation_ = Rot3::from_quat(field.at({0, 0, 0}), field.scale_at({0, 0, 0}));
   for (int l = 0; l < levels; ++l) {

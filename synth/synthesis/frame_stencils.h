@@ -29,6 +29,9 @@ class FrameStencils {
   int levels() const { return levels_; }
   bool constant() const { return constant_; }
   int reach(PyramidLevel l) const { return reach_[size_t(l.index)]; }
+  // Bounds the candidate offsets (ReadStencil::candidate: one in-plane step) per axis, at every
+  // level: what a patch vote (patch_vote.h) reads around a voxel.
+  int candidate_reach() const { return candidate_reach_; }
 
   // The frame of voxel p at level l.
   Rot3 rotation(PyramidLevel l, const Voxel& p) const;
@@ -45,6 +48,7 @@ class FrameStencils {
   bool constant_ = false;
   Rot3 constant_rotation_;
   std::vector<int> reach_;               // per level
+  int candidate_reach_ = 1;
   std::vector<ReadStencil> stencils_;    // per level, constant fields only
   std::vector<Offsets> offsets_;         // per level, constant fields only
 };

@@ -27,10 +27,19 @@ const char* init_name(Init i) { return i == Init::kAuto ? "auto" : i == Init::kS
 Result<ColorRule> parse_color_rule(const std::string& name) {
   if (name == "mean") return ColorRule::kMean;
   if (name == "medoid") return ColorRule::kMedoid;
-  return Status(StatusCode::kInvalidArgument, "unknown color '" + name + "' (mean, medoid)", "color");
+  if (name == "vote") return ColorRule::kVote;
+  if (name == "auto") return ColorRule::kAuto;
+  return Status(StatusCode::kInvalidArgument, "unknown color '" + name + "' (auto, vote, medoid, mean)", "color");
 }
 
-const char* color_rule_name(ColorRule c) { return c == ColorRule::kMean ? "mean" : "medoid"; }
+const char* color_rule_name(ColorRule c) {
+  switch (c) {
+    case ColorRule::kMean: return "mean";
+    case ColorRule::kVote: return "vote";
+    case ColorRule::kAuto: return "auto";
+    default: return "medoid";
+  }
+}
 
 Result<Matcher> parse_matcher(const std::string& name) {
   if (name == "paper") return Matcher::kPaper;

@@ -47,6 +47,10 @@ enum class ColorRule {
             // color none of them has, which blurs edges and flattens contrast
   kMedoid,  // the pixel whose plane-weighted squared color distance to the other two is least:
             // always an exemplar color (README, Quality: worst swd 3-10 % lower on 4 of 5 exemplars)
+  kVote,    // the exemplar pixel the voxel's neighbours' patches continue into it most often
+            // (synthesis/patch_vote.h): reads the final triples one step around the voxel
+  kAuto,    // kVote for a one-image (isotropic) exemplar, kMedoid for three planes (grain
+            // layouts, crossed), as measured (README, Quality, "Patch votes"); resolved_color_rule()
 };
 Result<ColorRule> parse_color_rule(const std::string& name);
 const char* color_rule_name(ColorRule c);
@@ -71,9 +75,10 @@ struct SynthesisParams {
   // lose the slabs' streaks along z; grained solids keep their slabs. Volumes pin it, and
   // volumes stored before restore with kSlab. It depends on the table only, so it is stable.
   Init init = Init::kAuto;
-  // Output colors: medoid by default; volumes stored before it was pinned restore with kMean.
-  // Matching colors (the coarser levels' neighbourhoods) stay plane-weighted means.
-  ColorRule color = ColorRule::kMedoid;
+  // Output colors: auto by default (README, Quality: "Patch votes"); volumes stored before it
+  // was pinned restore with kMean, volumes pinned to medoid keep it. Matching colors (the
+  // coarser levels' neighbourhoods) stay plane-weighted means, so every rule has the same triples.
+  ColorRule color = ColorRule::kAuto;
   int init_subpart = 32;     // K: coarsest-level voxels per slab-initialisation subpart side, even, [8, 256]
   int trilinear_levels = 2;  // the coarsest this-many levels sample neighborhoods trilinearly, [0, 8]
   uint32_t seed = 1;         // hashed with (voxel, level) wherever synthesis needs randomness

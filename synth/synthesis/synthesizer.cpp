@@ -16,6 +16,7 @@
 #include "synthesis/dependency.h"
 #include "synthesis/frame_stencils.h"
 #include "synthesis/level_store.h"
+#include "synthesis/patch_vote.h"
 #include "synthesis/pyramid_init.h"
 
 namespace solidtex {
@@ -151,6 +152,7 @@ void add_stats(SynthesisStats& into, const SynthesisStats& piece) {
     a.seconds += b.seconds;
   }
   into.dependency_seconds += piece.dependency_seconds;
+  into.support_voxels += piece.support_voxels;
   into.store_bytes = std::max(into.store_bytes, piece.store_bytes);
   into.estimated_bytes = std::max(into.estimated_bytes, piece.estimated_bytes);
   into.unsound_reads += piece.unsound_reads;
@@ -331,14 +333,27 @@ Result<std::vector<int>> Synthesizer::spread(LatchedInterrupter& interrupter) co
   return impl_->spread;
 }
 
+int Synthesizer::support_reach(PyramidLevel top) const {
+  return impl_->contexts[size_t(top.index)].color_rule == ColorRule::kVote ? impl_->stencils.candidate_reach() : 0;
+}
+
+TargetSet Synthesizer::color_support(const TargetSet& target, PyramidLevel top) const {
+  if (impl_->contexts[size_t(top.index)].color_rule != ColorRule::kVote) return target;
+  std::vector<Voxel> support = vote_support(target.voxels, impl_->stencils, top);
+  const int n = int(support.size());
+  return TargetSet::from_voxels(support, n, 1);
+}
+
 Result<RequestCost> Synthesizer::estimate(const TargetSet& target, Interrupter& interrupter) const {
   LatchedInterrupter poller(interrupter);
   SOLIDTEX_ASSIGN_OR_RETURN(const std::vector<int> spread, this->spread(poller));
   const auto pieces = split_target(target, kPieceCell);
-  if (pieces.size() == 1) return estimate_cost(schedules_, impl_->stencils, spread, target);
+  const PyramidLevel finest{table_->levels() - 1};
+  const int reach = support_reach(finest);
+  if (pieces.size() == 1) return estimate_cost(schedules_, impl_->stencils, spread, target, reach);
   RequestCost worst;
   for (const auto& piece : pieces) {
-    RequestCost c = estimate_cost(schedules_, impl_->stencils, spread, piece_target(target, piece));
+    RequestCost c = estimate_cost(schedules_, impl_->stencils, spread, piece_target(target, piece), reach);
     if (c.bytes > worst.bytes) worst = std::move(c);
   }
   return worst;
@@ -349,18 +364,22 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize_piece(const Ta
                                                                         const SynthesisOptions& options) {
   const int L = table_->levels();
   const PyramidLevel top{options.level < 0 ? L - 1 : options.level};
+  const std::vector<Voxel>& colored = target.voxels;
   if (options.max_bytes > 0) {
     // The estimate treats the target as finest voxels: an upper bound for coarser targets.
     SOLIDTEX_ASSIGN_OR_RETURN(const std::vector<int> spread, this->spread(poller));
-    const RequestCost cost = estimate_cost(schedules_, impl_->stencils, spread, target);
+    const RequestCost cost = estimate_cost(schedules_, impl_->stencils, spread, target, support_reach(top));
     stats.estimated_bytes = cost.bytes;
     if (cost.bytes > options.max_bytes) return too_much_memory(cost.bytes, options.max_bytes, options.target_field);
   }
+  // Listed only once the estimate allows it: a vote support holds up to 19x the target.
+  const TargetSet synthesized = color_support(target, top);
+  stats.support_voxels = int64_t(synthesized.voxels.size());
 
   // Backwards: what the target depends on.
   const auto t_dep = Clock::now();
   const DependencyInputs inputs{&schedules_, &impl_->stencils, options.use_cache ? cache_.get() : nullptr};
-  SOLIDTEX_ASSIGN_OR_RETURN(const std::vector<LevelDependencies> deps, analyze_dependencies(inputs, target, top, poller));
+  SOLIDTEX_ASSIGN_OR_RETURN(const std::vector<LevelDependencies> deps, analyze_dependencies(inputs, synthesized, top, poller));
   for (int l = 0; l <= top.index; ++l) {
     LevelStats& ls = stats.levels[size_t(l)];
     ls.level = l;
@@ -397,16 +416,39 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize_piece(const Ta
     parent = std::move(store);
   }
 
-  // Output colors of the target level's final versions.
+  // Output colors of the target level's final versions (votes read the support around them).
   const LevelSchedule& fsch = schedules_[size_t(top.index)];
   const CorrectionContext& fctx = impl_->contexts[size_t(top.index)];
-  std::vector<std::array<float, 3>> voxel_rgb(target.voxels.size());
-  for (size_t i = 0; i < target.voxels.size(); ++i) {
-    const Voxel& p = target.voxels[i];
-    const int slot = fsch.slot(p, fsch.final_version());
-    checks.read(*parent, p, slot);
-    output_color(*table_, parent->triple(p, slot), fctx.color_weights, fctx.color_rule, voxel_rgb[i].data());
-  }
+  std::vector<std::array<float, 3>> voxel_rgb(colored.size());
+  std::atomic<bool> outside{false};
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, colored.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
+    ReadStencil local;
+    auto final_triple = [&](const Voxel& q) -> CoordinateTriple {
+      const int slot = fsch.slot(q, fsch.final_version());
+      if (!checks.read(*parent, q, slot) || !parent->has(q)) {
+        outside = true;
+        return {};
+      }
+      return parent->triple(q, slot);
+    };
+    for (size_t i = r.begin(); i != r.end(); ++i) {
+      const Voxel& p = colored[i];
+      const CoordinateTriple own = final_triple(p);
+      if (fctx.color_rule != ColorRule::kVote) {
+        output_color(*table_, own, fctx.color_weights, fctx.color_rule, voxel_rgb[i].data());
+        continue;
+      }
+      const ReadStencil& st = impl_->stencils.stencil(top, p, local);
+      VoteSources sources;
+      for (int k = 0; k < 3; ++k)
+        for (int ab = 0; ab < 9; ++ab) {
+          const auto& o = st.candidate[size_t(k)][size_t(ab)];
+          sources[size_t(k)][size_t(ab)] = final_triple({p.x + o[0], p.y + o[1], p.z + o[2]}).at[size_t(k)];
+        }
+      vote_color(*table_, fctx.color_weights, fctx.spacing, own, sources, voxel_rgb[i].data());
+    }
+  });
+  if (outside) return Status(StatusCode::kInternal, "an output color read a voxel outside the target level's sets");
   checks.count_unread(fsch, deps[size_t(top.index)], *parent);
   stats.unsound_reads = checks.unsound();
   stats.unread_required = checks.unread();

@@ -7,7 +7,8 @@
 //     initialisation or upsampling (pyramid_init.h); each correction step on exactly the voxels
 //     of its set that it updates, in parallel (TBB; correction.h);
 //  3. cache write-back of the level's final versions;
-//  4. output colors of the finest level's final versions.
+//  4. output colors of the finest level's final versions (with ColorRule::kVote, from the
+//     final triples around each target voxel: stage 1 starts from that support, patch_vote.h).
 // Instrumented mode (SynthesisOptions::instrument) checks the sets' soundness and tightness.
 // Purity: the value of (level, voxel, version) depends only on the table, field, parameters
 // and seed: never on the request, order, thread count or cache state (tests check bits).
@@ -47,6 +48,9 @@ struct SynthesisStats {
   double dependency_seconds = 0;
   int64_t store_bytes = 0;        // request-local storage at its peak level
   int64_t estimated_bytes = 0;    // the cost model's bound for the largest piece, when max_bytes > 0
+  // Target-level voxels whose final triples the output colors read: the target's, or with
+  // ColorRule::kVote its vote support (patch_vote.h); the target level's needed_final.
+  int64_t support_voxels = 0;
   // Instrumented mode only: reads outside the computed sets, and set members never read.
   int64_t unsound_reads = 0;
   int64_t unread_required = 0;
@@ -101,6 +105,11 @@ class Synthesizer {
  private:
   Synthesizer() = default;
   Result<std::vector<int>> spread(LatchedInterrupter& interrupter) const;
+  // The voxels of level `top` a request must synthesize to colour `target`: the target itself,
+  // or with ColorRule::kVote its vote support (patch_vote.h).
+  TargetSet color_support(const TargetSet& target, PyramidLevel top) const;
+  // How far (voxels per axis) that support reaches beyond the target.
+  int support_reach(PyramidLevel top) const;
   // One compact piece of a request: colors per target voxel (target.voxels order).
   Result<std::vector<std::array<float, 3>>> synthesize_piece(const TargetSet& piece, LatchedInterrupter& poller,
                                                              SynthesisStats& stats, const SynthesisOptions& options);

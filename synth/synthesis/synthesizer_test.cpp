@@ -9,6 +9,8 @@
 #include "analysis/analysis.h"
 #include "testkit/quality.h"
 #include "synthesis/correction.h"
+#include "synthesis/frame_stencils.h"
+#include "synthesis/patch_vote.h"
 #include "synthesis/pyramid_init.h"
 #include "synthesis/region_volume.h"
 #include "testkit/test_support.h"
@@ -142,36 +144,62 @@ TEST_F(SynthesizerTest, NeighbouringCutFindsItsVoxelsFinalInTheCacheWithTheSameB
 // the same triples a finest-level request computes on the way (found in its cache), and asking
 // for them first changes no finest voxel. Levels outside the pyramid are errors naming `level`.
 TEST_F(SynthesizerTest, CoarseLevelTargetsAreThatLevelsFinalVoxels) {
-  const SynthesisParams p = small_params();
   const int L = table_->levels();
-  auto fine_first = make(table_, "quat:0.9,0.1,0.3,0.2", p);
-  const auto finest = cut(*fine_first, 'z', 0, 0, 0, 16, 16);
-  // Level L-2 voxels under the cut's centre: parents of finest voxels (4..11, 4..11, 0).
-  std::vector<Voxel> coarse;
-  for (int y = 2; y < 6; ++y)
-    for (int x = 2; x < 6; ++x) coarse.push_back({x, y, 0});
-  std::vector<CoordinateTriple> triples;
-  std::vector<uint8_t> found;
-  ASSERT_EQ(fine_first->cache().lookup(PyramidLevel{L - 2}, coarse, triples, found), int64_t(coarse.size()));
-  const CorrectionContext ctx = CorrectionContext::make(*table_, PyramidLevel{L - 2}, p);
-  for (const int level : {L - 2, 0}) {
-    auto coarse_first = make(table_, "quat:0.9,0.1,0.3,0.2", p);
-    SynthesisOptions o;
-    o.level = level;
-    o.max_bytes = int64_t(1) << 30;  // the memory checks walk every level's sets
-    SynthesisStats st;
-    auto got = coarse_first->synthesize(TargetSet::box({2, 2, 0}, 4, 4, 1).value(), null_interrupter(), &st, o);
-    ASSERT_TRUE(got.is_ok()) << got.status().to_string();
-    ASSERT_EQ(got->size(), coarse.size());
-    for (int l = level + 1; l < L; ++l) EXPECT_EQ(st.levels[size_t(l)].voxels, 0) << "level " << l << " was synthesized";
-    if (level == L - 2)
-      for (size_t i = 0; i < coarse.size(); ++i) {
-        float want[3];
-        output_color(*table_, triples[i], ctx.color_weights, ctx.color_rule, want);
-        EXPECT_EQ((*got)[i], (std::array<float, 3>{want[0], want[1], want[2]})) << i;
+  for (const ColorRule rule : {ColorRule::kVote, ColorRule::kMedoid}) {
+    SynthesisParams p = small_params();
+    p.color = rule;
+    auto fine_first = make(table_, "quat:0.9,0.1,0.3,0.2", p);
+    const auto finest = cut(*fine_first, 'z', 0, 0, 0, 16, 16);
+    // Level L-2 voxels under the cut's centre: parents of finest voxels (4..11, 4..11, 0).
+    std::vector<Voxel> coarse;
+    for (int y = 2; y < 6; ++y)
+      for (int x = 2; x < 6; ++x) coarse.push_back({x, y, 0});
+    const PyramidLevel level2{L - 2};
+    auto cached = [&](const std::vector<Voxel>& voxels) {
+      std::vector<CoordinateTriple> triples;
+      std::vector<uint8_t> found;
+      EXPECT_EQ(fine_first->cache().lookup(level2, voxels, triples, found), int64_t(voxels.size()));
+      return triples;
+    };
+    const std::vector<CoordinateTriple> triples = cached(coarse);
+    const CorrectionContext ctx = CorrectionContext::make(*table_, level2, p);
+    const FrameStencils frames =
+        FrameStencils::make(fine_first->field(), table_->params().neighborhood, L, p.trilinear_levels).value();
+    // The documented colour of each coarse voxel from the cached final triples (patch_vote.h).
+    auto want_color = [&](size_t i) {
+      std::array<float, 3> want;
+      if (rule != ColorRule::kVote) {
+        output_color(*table_, triples[i], ctx.color_weights, ctx.color_rule, want.data());
+        return want;
       }
-    EXPECT_EQ(cut(*coarse_first, 'z', 0, 0, 0, 16, 16), finest) << "a coarse request first changed finest voxels";
+      ReadStencil scratch;
+      const ReadStencil& st = frames.stencil(level2, coarse[i], scratch);
+      std::vector<Voxel> around;
+      for (const auto& plane : st.candidate)
+        for (const auto& o : plane) around.push_back({coarse[i].x + o[0], coarse[i].y + o[1], coarse[i].z + o[2]});
+      const std::vector<CoordinateTriple> t = cached(around);
+      VoteSources src;
+      for (int k = 0; k < 3; ++k)
+        for (int ab = 0; ab < 9; ++ab) src[size_t(k)][size_t(ab)] = t[size_t(k * 9 + ab)].at[size_t(k)];
+      vote_color(*table_, ctx.color_weights, ctx.spacing, triples[i], src, want.data());
+      return want;
+    };
+    for (const int level : {L - 2, 0}) {
+      auto coarse_first = make(table_, "quat:0.9,0.1,0.3,0.2", p);
+      SynthesisOptions o;
+      o.level = level;
+      o.max_bytes = int64_t(1) << 30;  // the memory checks walk every level's sets
+      SynthesisStats st;
+      auto got = coarse_first->synthesize(TargetSet::box({2, 2, 0}, 4, 4, 1).value(), null_interrupter(), &st, o);
+      ASSERT_TRUE(got.is_ok()) << got.status().to_string();
+      ASSERT_EQ(got->size(), coarse.size());
+      for (int l = level + 1; l < L; ++l) EXPECT_EQ(st.levels[size_t(l)].voxels, 0) << "level " << l << " was synthesized";
+      if (level == L - 2)
+        for (size_t i = 0; i < coarse.size(); ++i) EXPECT_EQ((*got)[i], want_color(i)) << color_rule_name(rule) << " " << i;
+      EXPECT_EQ(cut(*coarse_first, 'z', 0, 0, 0, 16, 16), finest) << "a coarse request first changed finest voxels";
+    }
   }
+  const SynthesisParams p = small_params();
   auto s = make(table_, "identity", p);
   for (const int bad : {-2, L}) {
     SynthesisOptions o;
@@ -441,7 +469,6 @@ TEST(SynthesizerQuality, MedoidColorsAreExemplarColorsAndNoBlurrierThanMeans) {
     }
   };
   double share_medoid = 0, sharp_medoid = 0, share_mean = 0, sharp_mean = 0;
-  EXPECT_EQ(SynthesisParams{}.color, ColorRule::kMedoid);
   cuts(ColorRule::kMedoid, share_medoid, sharp_medoid);
   cuts(ColorRule::kMean, share_mean, sharp_mean);
   std::printf("exemplar colors: medoid %.3f, mean %.3f; sharpness: medoid %.3f, mean %.3f\n", share_medoid, share_mean,
@@ -449,6 +476,58 @@ TEST(SynthesizerQuality, MedoidColorsAreExemplarColorsAndNoBlurrierThanMeans) {
   EXPECT_EQ(share_medoid, 1.0);
   EXPECT_LT(share_mean, 0.9) << "the three planes always agree here: the test no longer tells the rules apart";
   EXPECT_GE(sharp_medoid, sharp_mean);
+}
+
+// Patch votes (the default output colors) copy exemplar patches where the medoid of each voxel's
+// own triple makes a mosaic of single exemplar pixels: the share of a cut's neighbouring pixel
+// pairs that are neighbouring exemplar pixels (along either exemplar axis, as the planes hold
+// it) rises well above the medoid's, and the cut stays exemplar colours, as sharp as the medoid's.
+TEST(SynthesizerQuality, VoteColorsCopyExemplarPatchesWhereMedoidsMakeAMosaic) {
+  EXPECT_EQ(SynthesisParams{}.color, ColorRule::kAuto);
+  const auto table = small_table(ProceduralKind::kPebbles, false);
+  EXPECT_EQ(resolved_color_rule(*table, ColorRule::kAuto), ColorRule::kVote);
+  EXPECT_EQ(resolved_color_rule(*small_table(ProceduralKind::kWood, true), ColorRule::kAuto), ColorRule::kMedoid);
+  const ImageF& e = table->exemplars().plane(Plane::kXY);
+  using Pair = std::array<float, 6>;
+  std::vector<Pair> pairs;
+  for (int y = 0; y < e.height; ++y)
+    for (int x = 0; x < e.width; ++x)
+      for (const auto& [dx, dy] : {std::pair{1, 0}, std::pair{0, 1}}) {
+        const float* a = e.wrapped(x, y);
+        const float* b = e.wrapped(x + dx, y + dy);
+        pairs.push_back({a[0], a[1], a[2], b[0], b[1], b[2]});
+      }
+  std::sort(pairs.begin(), pairs.end());
+  auto continuity = [&](const std::vector<std::array<float, 3>>& rgb, int w, int h) {
+    int64_t in = 0, all = 0;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x)
+        for (const auto& [dx, dy] : {std::pair{1, 0}, std::pair{0, 1}}) {
+          if (x + dx >= w || y + dy >= h) continue;
+          const auto& a = rgb[size_t(y) * w + x];
+          const auto& b = rgb[size_t(y + dy) * w + x + dx];
+          in += std::binary_search(pairs.begin(), pairs.end(), Pair{a[0], a[1], a[2], b[0], b[1], b[2]});
+          ++all;
+        }
+    return double(in) / double(all);
+  };
+  double cont[2] = {0, 0}, sharp[2] = {0, 0};
+  for (const ColorRule rule : {ColorRule::kMedoid, ColorRule::kVote}) {
+    SynthesisParams p = small_params();
+    p.passes = SynthesisParams{}.passes;
+    p.color = rule;
+    auto s = make(table, "identity", p, 0);
+    const int i = rule == ColorRule::kVote;
+    for (char axis : {'x', 'z'}) {
+      const auto rgb = cut(*s, axis, 7, 0, 0, 40, 40);
+      cont[i] += continuity(rgb, 40, 40) / 2;
+      sharp[i] += sharpness_ratio(rgb_image(rgb, 40, 40), e) / 2;
+    }
+  }
+  std::printf("exemplar-neighbour pairs: medoid %.3f, vote %.3f; sharpness: medoid %.3f, vote %.3f\n", cont[0], cont[1],
+              sharp[0], sharp[1]);
+  EXPECT_GT(cont[1], 3 * cont[0]);
+  EXPECT_GT(sharp[1], 0.9 * sharp[0]);
 }
 
 // Luminance autocorrelation of an image at `lag` pixels along its rows' direction (x) minus

@@ -5,6 +5,7 @@
 
 #include "analysis/table.h"
 #include "core/image.h"
+#include "synthesis/correction.h"
 
 namespace solidtex {
 namespace {
@@ -84,13 +85,15 @@ double fine_detail_share(const Table& table) {
   return share(e0, e1);
 }
 
-VoxelSampling preferred_voxel_sampling(const Table& table) {
-  return fine_detail_share(table) < kCubicMaxFineDetailShare ? VoxelSampling::kCubic : VoxelSampling::kNearest;
+VoxelSampling preferred_voxel_sampling(const Table& table, ColorRule color) {
+  const double threshold =
+      resolved_color_rule(table, color) == ColorRule::kVote ? kCubicMaxFineDetailShareVote : kCubicMaxFineDetailShare;
+  return fine_detail_share(table) < threshold ? VoxelSampling::kCubic : VoxelSampling::kNearest;
 }
 
-VoxelSampling preferred_voxel_sampling(const std::vector<std::shared_ptr<const Table>>& tables) {
+VoxelSampling preferred_voxel_sampling(const std::vector<std::shared_ptr<const Table>>& tables, ColorRule color) {
   for (const auto& t : tables)
-    if (preferred_voxel_sampling(*t) == VoxelSampling::kNearest) return VoxelSampling::kNearest;
+    if (preferred_voxel_sampling(*t, color) == VoxelSampling::kNearest) return VoxelSampling::kNearest;
   return tables.empty() ? VoxelSampling::kNearest : VoxelSampling::kCubic;
 }
 

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "core/status.h"
+#include "synthesis/synthesis_params.h"
 
 namespace solidtex {
 
@@ -44,10 +45,15 @@ double fine_detail_share(const ImageF& linear_rgb);
 double fine_detail_share(const Table& table);
 
 inline constexpr double kCubicMaxFineDetailShare = 0.43;
-// kCubic when fine_detail_share(table) < kCubicMaxFineDetailShare, else kNearest.
-VoxelSampling preferred_voxel_sampling(const Table& table);
+// With patch-vote colours (ColorRule::kVote) cuts are exemplar patches, not single-voxel
+// mosaics, and cubic resampling pays up to more detail: better on bricks (0.51) and marble
+// (0.46), still worse on weave (0.59), tree_bark (0.58) and wood_grain (0.68) (README, Quality).
+inline constexpr double kCubicMaxFineDetailShareVote = 0.55;
+// kCubic when fine_detail_share(table) is below the threshold of the table's resolved colour
+// rule (`color`, resolved_color_rule), else kNearest.
+VoxelSampling preferred_voxel_sampling(const Table& table, ColorRule color);
 // Of a volume of several tables (a region volume): kCubic only when every table prefers it,
 // so that an exemplar with 1-voxel detail keeps it.
-VoxelSampling preferred_voxel_sampling(const std::vector<std::shared_ptr<const Table>>& tables);
+VoxelSampling preferred_voxel_sampling(const std::vector<std::shared_ptr<const Table>>& tables, ColorRule color);
 
 }  // namespace solidtex

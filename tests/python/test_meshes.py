@@ -339,7 +339,8 @@ def test_surface_stats_dual_grid_and_plain(env):
             assert [lv["voxels_synthesized"] for lv in volume_levels] == \
                 [lv["voxels"] for lv in levels], (volume_levels, levels)
             assert all(lv["cache_hits"] == 0 for lv in levels), st
-            assert levels[-1]["needed_final"] == st["target_voxels"], st
+            # what the colors read: the target, or with patch votes one step around it too
+            assert levels[-1]["needed_final"] == st["support_voxels"] >= st["target_voxels"], st
             assert levels[-1]["voxels"] >= st["target_voxels"], st
             assert 0 < st["corrections"] == sum(lv["corrections"] for lv in levels), st
             assert math.isclose(st["fraction"], st["voxels_synthesized"] / st["bounding_voxels"],

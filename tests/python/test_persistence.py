@@ -135,7 +135,7 @@ def test_volumes_stored_before_a_default_changed_keep_their_voxels(server, exemp
     c = a.client
     ex = upload_ready(c, exemplars["spots"])
     vol = c.create_volume(exemplar=ex["id"], seed=4)
-    assert vol["params"] == {"typicality": 0.5, "passes": 1, "init": "auto", "color": "medoid", "finest_subpass_size": 1,
+    assert vol["params"] == {"typicality": 0.5, "passes": 1, "init": "auto", "color": "auto", "finest_subpass_size": 1,
                              "balance": 1.0}, vol
     legacy = c.create_volume(exemplar=ex["id"], seed=4, params={"typicality": 0, "passes": 2, "init": "slab", "color": "mean",
                                                                     "finest_subpass_size": 2, "balance": 0})
@@ -153,13 +153,14 @@ def test_volumes_stored_before_a_default_changed_keep_their_voxels(server, exemp
     want_late = c.slice(mean["id"], "z", 2, (24, 24))
     assert not np.array_equal(c.slice(late["id"], "z", 2, (24, 24)), want_late), "color changed nothing"
     # made when color was pinned but finest_subpass_size was not
-    recent = c.create_volume(exemplar=ex["id"], seed=7)
-    eight = c.create_volume(exemplar=ex["id"], seed=7, params={"finest_subpass_size": 2, "balance": 0})
+    # (color was medoid by default then; it is pinned, so a later default changes nothing stored)
+    recent = c.create_volume(exemplar=ex["id"], seed=7, params={"color": "medoid"})
+    eight = c.create_volume(exemplar=ex["id"], seed=7, params={"color": "medoid", "finest_subpass_size": 2, "balance": 0})
     want_recent = c.slice(eight["id"], "z", 2, (24, 24))
     assert not np.array_equal(c.slice(recent["id"], "z", 2, (24, 24)), want_recent), "subpasses changed nothing"
     # made when finest_subpass_size was pinned but balance was not
-    newest = c.create_volume(exemplar=ex["id"], seed=8)
-    unbalanced = c.create_volume(exemplar=ex["id"], seed=8, params={"balance": 0})
+    newest = c.create_volume(exemplar=ex["id"], seed=8, params={"color": "medoid"})
+    unbalanced = c.create_volume(exemplar=ex["id"], seed=8, params={"color": "medoid", "balance": 0})
     want_newest = c.slice(unbalanced["id"], "z", 2, (24, 24))
     assert not np.array_equal(c.slice(newest["id"], "z", 2, (24, 24)), want_newest), "balance changed nothing"
     assert a.stop(grace=10) == 0

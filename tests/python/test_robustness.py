@@ -162,11 +162,13 @@ def test_finest_subpass_size_takes_1_and_2_only(srv):
     assert cuts[1] != cuts[2]
 
 
-def test_color_takes_its_two_names_only(srv):
-    # medoid (the default) and mean synthesize the same triples and differ in colors only
-    cuts = takes_its_values_only(srv, "color", ("medoid", "mean"), "medoid",
-                                 ("median", "Mean", "", 0, None, ["mean"], {"rule": "mean"}))
-    assert cuts["medoid"] != cuts["mean"]
+def test_color_takes_its_four_names_only(srv):
+    # auto (the default: vote for one image, medoid for three planes), vote, medoid and mean
+    # synthesize the same triples and differ in colors only
+    cuts = takes_its_values_only(srv, "color", ("auto", "vote", "medoid", "mean"), "auto",
+                                 ("median", "Mean", "Vote", "", 0, None, ["mean"], {"rule": "mean"}))
+    assert cuts["auto"] in (cuts["vote"], cuts["medoid"])
+    assert cuts["vote"] != cuts["medoid"] != cuts["mean"] != cuts["vote"]
 
 
 @pytest.mark.parametrize("spec", ["identity;scale:2.1,1,1", "axis:0,0,1,30;scale:3,1,1"])
