@@ -372,7 +372,7 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize_piece(const Ta
     stats.estimated_bytes = cost.bytes;
     if (cost.bytes > options.max_bytes) return too_much_memory(cost.bytes, options.max_bytes, options.target_field);
   }
-  // Listed only once the estimate allows it: a vote support holds up to 19x the target.
+  // Listed only once the estimate allows it: a vote support holds up to 27x the target.
   const TargetSet synthesized = color_support(target, top);
   stats.support_voxels = int64_t(synthesized.voxels.size());
 
