@@ -21,17 +21,16 @@ void vote_color(const Table& table, const PlaneWeights& w, int spacing, const Co
   };
   std::array<Vote, 27> votes;
   int count = 0;
-  constexpr std::array<Plane, 3> kPlanes{Plane::kXY, Plane::kYZ, Plane::kZX};
   for (int k = 0; k < 3; ++k) {
     if (!(w[size_t(k)] > 0.f)) continue;
     // Planes holding the same image pool their votes under the first such plane's index.
     int image = k;
     for (int j = 0; j < k; ++j)
-      if (e.plane_ptr(kPlanes[size_t(j)]) == e.plane_ptr(kPlanes[size_t(k)])) {
+      if (e.plane_ptr(Plane(j)) == e.plane_ptr(Plane(k))) {
         image = j;
         break;
       }
-    const ImageF& img = e.plane(kPlanes[size_t(k)]);
+    const ImageF& img = e.plane(Plane(k));
     const float weight = w[size_t(k)] / top;
     for (int ab = 0; ab < 9; ++ab) {
       const int a = ab % 3 - 1, b = ab / 3 - 1;

@@ -1,4 +1,5 @@
-// Output colours by patch vote (ColorRule::kVote, the default for new volumes).
+// Output colours by patch vote (ColorRule::kVote; what kAuto, the default, resolves to for a
+// one-image exemplar: resolved_color_rule in correction.h).
 //
 // Why: per-voxel k-coherence (correction.h) leaves each plane's coordinates continuing a
 // neighbour's patch only about a fifth of the time, so colouring every voxel from its own
@@ -14,8 +15,9 @@
 // pool their votes. The pixel whose summed weight minus kVoteColorPull times the squared RGB
 // distance of its colour to p's medoid colour (output_color) is largest wins; ties go to the
 // lowest (image, y, x). The output is that pixel's RGB in its plane's original exemplar: always
-// an exemplar colour, a pure function of the final triples of p's 27 stencil neighbours and so
-// of (table, field, parameters, seed, voxel). Reads beyond the voxel's own triple are why a
+// an exemplar colour, a pure function of the final triples at p's 27 candidate offsets (p and
+// its 18 face and edge neighbours under the identity frame) and so of (table, field,
+// parameters, seed, voxel). Reads beyond the voxel's own triple are why a
 // request synthesizes vote_support() of its target, not only the target.
 // Thread-safety: pure functions.
 #pragma once

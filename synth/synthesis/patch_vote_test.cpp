@@ -25,8 +25,6 @@ std::shared_ptr<const Table> three_image_table() {
   return analyze(ExemplarSet::create(std::move(in)).value(), p).value().table;
 }
 
-constexpr std::array<Plane, 3> kPlanes{Plane::kXY, Plane::kYZ, Plane::kZX};
-
 ExemplarPixel random_pixel(uint64_t trial, int k, int ab, int w) {
   return {int(hash_u64(trial, k, ab, 11) % uint64_t(3 * w)) - w, int(hash_u64(trial, k, ab, 12) % uint64_t(3 * w)) - w};
 }
@@ -54,7 +52,7 @@ TEST(PatchVote, NeighboursContinuingOnePatchWin) {
           src[size_t(k)][size_t(ab)] = {patch.x + spacing * (ab % 3 - 1), patch.y + spacing * (ab / 3 - 1)};
         float rgb[3];
         vote_color(*table, pw, spacing, own, src, rgb);
-        ASSERT_TRUE(same_rgb(rgb, e.plane(kPlanes[size_t(k)]).wrapped(patch.x, patch.y)))
+        ASSERT_TRUE(same_rgb(rgb, e.plane(Plane(k)).wrapped(patch.x, patch.y)))
             << "plane " << k << " spacing " << spacing << " trial " << trial;
       }
 }
@@ -86,7 +84,7 @@ TEST(PatchVote, ScatteredVotesGiveAVotedPixelNearTheMedoid) {
         if (raw[size_t(j)] == 0.f) continue;
         for (int ab = 0; ab < 9; ++ab) {
           const ExemplarPixel s = src[size_t(j)][size_t(ab)];
-          const float* c = e.plane(kPlanes[size_t(j)]).wrapped(s.x - (ab % 3 - 1), s.y - (ab / 3 - 1));
+          const float* c = e.plane(Plane(j)).wrapped(s.x - (ab % 3 - 1), s.y - (ab / 3 - 1));
           voted = voted || same_rgb(rgb, c);
           nearest = std::min(nearest, d2(c));
         }

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <map>
 #include <mutex>
+#include <numeric>
 #include <string>
 #include <type_traits>
 
@@ -339,9 +340,15 @@ int Synthesizer::support_reach(PyramidLevel top) const {
 
 TargetSet Synthesizer::color_support(const TargetSet& target, PyramidLevel top) const {
   if (impl_->contexts[size_t(top.index)].color_rule != ColorRule::kVote) return target;
-  std::vector<Voxel> support = vote_support(target.voxels, impl_->stencils, top);
-  const int n = int(support.size());
-  return TargetSet::from_voxels(support, n, 1);
+  // vote_support is sorted and distinct already: sample i is voxel i (from_voxels would sort
+  // and search it again).
+  TargetSet support;
+  support.voxels = vote_support(target.voxels, impl_->stencils, top);
+  support.width = int(support.voxels.size());
+  support.height = 1;
+  support.sample.resize(support.voxels.size());
+  std::iota(support.sample.begin(), support.sample.end(), 0u);
+  return support;
 }
 
 Result<RequestCost> Synthesizer::estimate(const TargetSet& target, Interrupter& interrupter) const {
@@ -364,7 +371,6 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize_piece(const Ta
                                                                         const SynthesisOptions& options) {
   const int L = table_->levels();
   const PyramidLevel top{options.level < 0 ? L - 1 : options.level};
-  const std::vector<Voxel>& colored = target.voxels;
   if (options.max_bytes > 0) {
     // The estimate treats the target as finest voxels: an upper bound for coarser targets.
     SOLIDTEX_ASSIGN_OR_RETURN(const std::vector<int> spread, this->spread(poller));
@@ -419,9 +425,9 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize_piece(const Ta
   // Output colors of the target level's final versions (votes read the support around them).
   const LevelSchedule& fsch = schedules_[size_t(top.index)];
   const CorrectionContext& fctx = impl_->contexts[size_t(top.index)];
-  std::vector<std::array<float, 3>> voxel_rgb(colored.size());
+  std::vector<std::array<float, 3>> voxel_rgb(target.voxels.size());
   std::atomic<bool> outside{false};
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, colored.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, target.voxels.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
     ReadStencil local;
     auto final_triple = [&](const Voxel& q) -> CoordinateTriple {
       const int slot = fsch.slot(q, fsch.final_version());
@@ -432,7 +438,7 @@ Result<std::vector<std::array<float, 3>>> Synthesizer::synthesize_piece(const Ta
       return parent->triple(q, slot);
     };
     for (size_t i = r.begin(); i != r.end(); ++i) {
-      const Voxel& p = colored[i];
+      const Voxel& p = target.voxels[i];
       const CoordinateTriple own = final_triple(p);
       if (fctx.color_rule != ColorRule::kVote) {
         output_color(*table_, own, fctx.color_weights, fctx.color_rule, voxel_rgb[i].data());
