@@ -208,6 +208,36 @@ def test_line_shaped_cut_is_refused_by_the_cost_model_at_once(srv):
     alive(srv)
 
 
+def test_vote_colors_at_the_extremes_are_refused_or_answered_never_a_crash(srv):
+    # patch votes read one step around the target (support_voxels), forced on this grained
+    # exemplar (auto would pick medoid): a line-shaped cut and 140,000 scattered points are
+    # refused by the cost model at once, naming what sets their size; a stretched field (wider
+    # candidate offsets), a coarse dataset and a deadline answer 200, 200 and 504; the process
+    # stays up
+    vid = create_volume(srv, params={"color": "vote"}).json()["id"]
+    t0 = time.monotonic()
+    err = assert_error(slice_of(srv, vid, size="4194304,1", timeout=5), 422, field_contains="size")
+    assert "MB of working memory" in err["message"], err
+    n = 140000
+    pts = np.stack([np.arange(n) * 7.0 + 0.3, np.full(n, 0.5), np.full(n, 0.5)], 1).astype("<f4")
+    r = requests.post(f"{srv.url}/v1/volumes/{vid}/points", params={"timeout": 10}, data=pts.tobytes(),
+                      headers={"Content-Type": "application/octet-stream"}, timeout=HTTP_TIMEOUT)
+    assert "MB of working memory" in assert_error(r, 422, field_contains="points")["message"]
+    assert time.monotonic() - t0 < 8
+    stretched = create_volume(srv, params={"color": "vote"}, field={"spec": "axis:0,0,1,30;scale:3,1,1"}).json()["id"]
+    got = slice_of(srv, stretched, size="24,24")
+    assert got.status_code == 200, got.text
+    assert np.isfinite(np.frombuffer(got.content, np.float32)).all()
+    coarse = requests.get(f"{srv.url}/v1/volumes/{vid}/slice", params={"axis": "z", "at": 0, "size": "8,8", "scale": 1},
+                          headers=RAW_F32, timeout=HTTP_TIMEOUT)
+    assert coarse.status_code == 200, coarse.text
+    slow = create_volume(srv, seed=12, params={"color": "vote", "passes": 3}).json()["id"]
+    t0 = time.monotonic()
+    assert_error(slice_of(srv, slow, size="256,256", timeout=1), 504, field_contains="timeout")
+    assert time.monotonic() - t0 < 2.0
+    alive(srv)
+
+
 def test_points_far_apart_cost_what_each_costs_alone(srv):
     vid = create_volume(srv).json()["id"]
     url = f"{srv.url}/v1/volumes/{vid}/points"
