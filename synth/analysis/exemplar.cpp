@@ -138,7 +138,8 @@ Result<std::string> apply_grain_layout(const std::string& grain, ExemplarInputs&
     (along_x ? in.mask_zx : in.mask_yz) = transposed(*in.mask_xy);
     (along_x ? in.mask_yz : in.mask_zx) = in.mask_xy;
   }
-  suggested_plane_weights = along_x ? std::array<float, 3>{1.f, 0.1f, 1.f} : std::array<float, 3>{1.f, 1.f, 0.1f};
+  suggested_plane_weights = along_x ? std::array<float, 3>{1.f, kEndGrainWeight, 1.f}
+                                    : std::array<float, 3>{1.f, 1.f, kEndGrainWeight};
   return layout;
 }
 

@@ -166,9 +166,8 @@ void output_color(const Table& table, const CoordinateTriple& t, const PlaneWeig
   for (int k = 0; k < 3; ++k) rgb[k] = px[size_t(best)][k];
 }
 
-ColorRule resolved_color_rule(const Table& table, ColorRule rule) {
-  if (rule != ColorRule::kAuto) return rule;
-  return table.exemplars().shared() ? ColorRule::kVote : ColorRule::kMedoid;
+ColorRule resolved_color_rule(ColorRule rule) {
+  return rule == ColorRule::kAuto ? ColorRule::kVote : rule;
 }
 
 CorrectionContext CorrectionContext::make(const Table& table, PyramidLevel l, const SynthesisParams& params) {
@@ -176,7 +175,7 @@ CorrectionContext CorrectionContext::make(const Table& table, PyramidLevel l, co
   ctx.candidates_per_source = params.matcher == Matcher::kCoherent ? 4 : 64;
   ctx.cost_weights = params.plane_weights;
   ctx.color_weights = normalised_weights(params.plane_weights);
-  ctx.color_rule = resolved_color_rule(table, params.color);
+  ctx.color_rule = resolved_color_rule(params.color);
   ctx.typicality = params.typicality;
   ctx.level = &table.level(l);
   for (int k = 0; k < 3; ++k) {

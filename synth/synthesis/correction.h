@@ -75,9 +75,9 @@ void matching_color(const TableLevel& level, const CoordinateTriple& t, int chan
 // ties go to the lowest plane index, so it is a pure function of (table, triple, weights).
 // `w` are normalised weights (not all zero).
 void output_color(const Table& table, const CoordinateTriple& t, const PlaneWeights& w, ColorRule rule, float rgb[3]);
-// The rule `rule` stands for on `table`: kAuto is kVote for one image shared by the three planes,
-// else kMedoid (a fixed function of the table, like resolved_init). Other rules are themselves.
-ColorRule resolved_color_rule(const Table& table, ColorRule rule);
+// The rule `rule` stands for: kAuto is kVote on every table (one image, crossed, grain layouts:
+// README, Quality, "Grain layouts vote"). Other rules are themselves.
+ColorRule resolved_color_rule(ColorRule rule);
 
 // Per-level constants of the correction, precomputed once per synthesizer.
 struct CorrectionContext {

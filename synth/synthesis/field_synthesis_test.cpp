@@ -2,11 +2,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 
 #include "field/field_file.h"
 #include "field/sketch.h"
 #include "field/tensor_field.h"
 #include "analysis/analysis.h"
+#include "analysis/exemplar.h"
 #include "synthesis/synthesizer.h"
 #include "testkit/quality.h"
 #include "testkit/test_support.h"
@@ -28,13 +30,14 @@ std::shared_ptr<const Table> grain_table(const ImageF& xy, const ImageF& zx) {
   return analyze(ExemplarSet::create(std::move(in)).value(), ap).value().table;
 }
 
-// Synthesis parameters for grain_table(), end grain (yz) down-weighted.
+// Synthesis parameters for grain_table(), end grain (yz) down-weighted as apply_grain_layout
+// suggests.
 SynthesisParams grain_params() {
   SynthesisParams sp;
   sp.coarse_passes = 2;
   sp.cell_size = 8;
   sp.init_subpart = 16;
-  sp.plane_weights = {1.f, 0.1f, 1.f};
+  sp.plane_weights = {1.f, kEndGrainWeight, 1.f};
   // Two fine passes, as before the default became one: these tests measure how closely the
   // grain can follow a field. Measured over seeds 1-5, the concentric-circle median error is
   // 8.5 degrees (7.3-10.7) with two passes and 11.3 (9.3-13.4) with the default single pass.
@@ -63,32 +66,43 @@ TEST(TensorFieldSynthesis, ConcentricCirclesMakeTangentialGrain) {
 
   const ImageF stripes = testing::procedural(ProceduralKind::kStripes, 48, 48);
   auto table = grain_table(stripes, transposed(stripes));
-  auto synth = Synthesizer::create(table, field, grain_params(), 0).value();
   const int side = 72;
-  auto rgb = synth->synthesize(TargetSet::axis_cut('z', 0, -side / 2, -side / 2, side, side).value()).value();
-  ImageF img(side, side, 3);
-  for (size_t i = 0; i < rgb.size(); ++i)
-    for (int c = 0; c < 3; ++c) img.pixels[i * 3 + size_t(c)] = rgb[i][size_t(c)];
+  // The median error of one cut moves by several degrees from seed to seed (seeds 1-5 with
+  // the end grain at 0.1: 9.6 / 11.0 / 6.4 / 9.2 / 6.4; at 0.3: 12.8 / 8.1 / 7.5 / 9.2 / 6.5),
+  // so the bound holds for the mean over three volume seeds, not for one.
+  double mean_median = 0;
+  for (uint32_t seed : {1u, 2u, 3u}) {
+    SynthesisParams sp = grain_params();
+    sp.seed = seed;
+    auto synth = Synthesizer::create(table, field, sp, 0).value();
+    auto rgb = synth->synthesize(TargetSet::axis_cut('z', 0, -side / 2, -side / 2, side, side).value()).value();
+    ImageF img(side, side, 3);
+    for (size_t i = 0; i < rgb.size(); ++i)
+      for (int c = 0; c < 3; ++c) img.pixels[i * 3 + size_t(c)] = rgb[i][size_t(c)];
 
-  // Local grain orientation in 13x13 windows on rings of radius 12..30 versus the tangent.
-  std::vector<double> errors;
-  for (double r : {13.0, 18.0, 23.0, 28.0})
-    for (int k = 0; k < 16; ++k) {
-      const double a = 2 * M_PI * k / 16;
-      const int cx = int(std::lround(side / 2 + r * std::cos(a))), cy = int(std::lround(side / 2 + r * std::sin(a)));
-      ImageF win(13, 13, 3);
-      for (int y = 0; y < 13; ++y)
-        for (int x = 0; x < 13; ++x)
-          for (int c = 0; c < 3; ++c) win.at(x, y)[c] = img.at(cx - 6 + x, cy - 6 + y)[c];
-      const double grain = dominant_orientation_degrees(win);
-      double tangent = std::atan2(std::cos(a), -std::sin(a)) * 180 / M_PI;
-      double diff = std::fmod(std::abs(grain - tangent), 180.0);
-      errors.push_back(std::min(diff, 180.0 - diff));
-    }
-  std::sort(errors.begin(), errors.end());
-  const double median = errors[errors.size() / 2];
-  RecordProperty("median_error_degrees", std::to_string(median));
-  EXPECT_LE(median, 10.0);
+    // Local grain orientation in 13x13 windows on rings of radius 12..30 versus the tangent.
+    std::vector<double> errors;
+    for (double r : {13.0, 18.0, 23.0, 28.0})
+      for (int k = 0; k < 16; ++k) {
+        const double a = 2 * M_PI * k / 16;
+        const int cx = int(std::lround(side / 2 + r * std::cos(a))), cy = int(std::lround(side / 2 + r * std::sin(a)));
+        ImageF win(13, 13, 3);
+        for (int y = 0; y < 13; ++y)
+          for (int x = 0; x < 13; ++x)
+            for (int c = 0; c < 3; ++c) win.at(x, y)[c] = img.at(cx - 6 + x, cy - 6 + y)[c];
+        const double grain = dominant_orientation_degrees(win);
+        double tangent = std::atan2(std::cos(a), -std::sin(a)) * 180 / M_PI;
+        double diff = std::fmod(std::abs(grain - tangent), 180.0);
+        errors.push_back(std::min(diff, 180.0 - diff));
+      }
+    std::sort(errors.begin(), errors.end());
+    const double median = errors[errors.size() / 2];
+    RecordProperty("median_error_degrees_seed_" + std::to_string(seed), std::to_string(median));
+    std::printf("concentric rings, seed %u: median error %.2f degrees\n", seed, median);
+    mean_median += median / 3;
+  }
+  RecordProperty("mean_median_error_degrees", std::to_string(mean_median));
+  EXPECT_LE(mean_median, 10.0);
 }
 
 TEST(ScaleField, ScaleTwoAlongXDoublesThePeriod) {

@@ -1,5 +1,5 @@
-// Output colours by patch vote (ColorRule::kVote; what kAuto, the default, resolves to for a
-// one-image exemplar: resolved_color_rule in correction.h).
+// Output colours by patch vote (ColorRule::kVote; what kAuto, the default, resolves to on every
+// table: resolved_color_rule in correction.h).
 //
 // Why: per-voxel k-coherence (correction.h) leaves each plane's coordinates continuing a
 // neighbour's patch only about a fifth of the time, so colouring every voxel from its own

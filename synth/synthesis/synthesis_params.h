@@ -49,8 +49,9 @@ enum class ColorRule {
             // always an exemplar color (README, Quality: worst swd 3-10 % lower on 4 of 5 exemplars)
   kVote,    // the exemplar pixel the voxel's neighbours' patches continue into it most often
             // (synthesis/patch_vote.h): reads the final triples one step around the voxel
-  kAuto,    // kVote for a one-image (isotropic) exemplar, kMedoid for three planes (grain
-            // layouts, crossed), as measured (README, Quality, "Patch votes"); resolved_color_rule()
+  kAuto,    // kVote on every table: one image, crossed, grain layouts (whose end-grain weight
+            // rose to 0.3 with it), as measured (README, Quality, "Patch votes", "Grain layouts
+            // vote"); resolved_color_rule()
 };
 Result<ColorRule> parse_color_rule(const std::string& name);
 const char* color_rule_name(ColorRule c);

@@ -7,6 +7,7 @@
 #include <cstdio>
 
 #include "analysis/analysis.h"
+#include "analysis/exemplar.h"
 #include "testkit/quality.h"
 #include "synthesis/correction.h"
 #include "synthesis/frame_stencils.h"
@@ -30,7 +31,7 @@ std::shared_ptr<const Table> small_table(ProceduralKind kind, bool grain_x) {
   if (grain_x) {
     in.yz = in.xy;
     in.zx = transposed(in.xy);
-    p.suggested_plane_weights = {1.f, 0.1f, 1.f};
+    p.suggested_plane_weights = {1.f, kEndGrainWeight, 1.f};  // as apply_grain_layout("x") suggests
   }
   auto set = ExemplarSet::create(std::move(in)).value();
   return analyze(set, p).value().table;
@@ -482,11 +483,10 @@ TEST(SynthesizerQuality, MedoidColorsAreExemplarColorsAndNoBlurrierThanMeans) {
 // own triple makes a mosaic of single exemplar pixels: the share of a cut's neighbouring pixel
 // pairs that are neighbouring exemplar pixels (along either exemplar axis, as the planes hold
 // it) rises well above the medoid's, and the cut stays exemplar colours, as sharp as the medoid's.
-TEST(SynthesizerQuality, VoteColorsCopyExemplarPatchesWhereMedoidsMakeAMosaic) {
-  EXPECT_EQ(SynthesisParams{}.color, ColorRule::kAuto);
-  const auto table = small_table(ProceduralKind::kPebbles, false);
-  EXPECT_EQ(resolved_color_rule(*table, ColorRule::kAuto), ColorRule::kVote);
-  EXPECT_EQ(resolved_color_rule(*small_table(ProceduralKind::kWood, true), ColorRule::kAuto), ColorRule::kMedoid);
+// So on one image and on a grain layout (three planes, E and E^T: a pair along E^T's rows is
+// a pair along E's columns, so E's pairs cover both).
+void expect_votes_copy_patches(ProceduralKind kind, bool grain_x, double min_gain) {
+  const auto table = small_table(kind, grain_x);
   const ImageF& e = table->exemplars().plane(Plane::kXY);
   using Pair = std::array<float, 6>;
   std::vector<Pair> pairs;
@@ -524,10 +524,20 @@ TEST(SynthesizerQuality, VoteColorsCopyExemplarPatchesWhereMedoidsMakeAMosaic) {
       sharp[i] += sharpness_ratio(rgb_image(rgb, 40, 40), e) / 2;
     }
   }
-  std::printf("exemplar-neighbour pairs: medoid %.3f, vote %.3f; sharpness: medoid %.3f, vote %.3f\n", cont[0], cont[1],
-              sharp[0], sharp[1]);
-  EXPECT_GT(cont[1], 3 * cont[0]);
-  EXPECT_GT(sharp[1], 0.9 * sharp[0]);
+  std::printf("%s: exemplar-neighbour pairs: medoid %.3f, vote %.3f; sharpness: medoid %.3f, vote %.3f\n",
+              grain_x ? "grain x" : "one image", cont[0], cont[1], sharp[0], sharp[1]);
+  EXPECT_GT(cont[1], min_gain * cont[0]) << (grain_x ? "grain x" : "one image");
+  EXPECT_GT(sharp[1], 0.9 * sharp[0]) << (grain_x ? "grain x" : "one image");
+}
+
+TEST(SynthesizerQuality, VoteColorsCopyExemplarPatchesWhereMedoidsMakeAMosaic) {
+  EXPECT_EQ(SynthesisParams{}.color, ColorRule::kAuto);
+  EXPECT_EQ(resolved_color_rule(ColorRule::kAuto), ColorRule::kVote);
+  EXPECT_EQ(resolved_color_rule(ColorRule::kMedoid), ColorRule::kMedoid);
+  // Measured: 7.1 % -> 33 % on one image, 9.7 % -> 30 % on grain x (two images, so half the
+  // votes pool); sharpness 1.05 -> 1.06 and 1.17 -> 1.22.
+  expect_votes_copy_patches(ProceduralKind::kPebbles, false, 3.0);
+  expect_votes_copy_patches(ProceduralKind::kWood, true, 2.5);
 }
 
 // Luminance autocorrelation of an image at `lag` pixels along its rows' direction (x) minus

@@ -87,7 +87,7 @@ double fine_detail_share(const Table& table) {
 
 VoxelSampling preferred_voxel_sampling(const Table& table, ColorRule color) {
   const double threshold =
-      resolved_color_rule(table, color) == ColorRule::kVote ? kCubicMaxFineDetailShareVote : kCubicMaxFineDetailShare;
+      resolved_color_rule(color) == ColorRule::kVote ? kCubicMaxFineDetailShareVote : kCubicMaxFineDetailShare;
   return fine_detail_share(table) < threshold ? VoxelSampling::kCubic : VoxelSampling::kNearest;
 }
 

@@ -107,8 +107,10 @@ def test_too_many_analysis_jobs_is_429(server, exemplars):
 def test_client_disconnect_cancels_the_synthesis(busy):
     """A client that hangs up frees its worker long before the synthesis would have ended."""
     # Four fine passes of 8 subpasses: the default schedule cuts this in under half a second,
-    # this one takes about 11 s on this machine (five would exceed --max-request-mb: 422).
-    heavy = busy.client.create_volume(exemplar=busy.exemplar_id, seed=3, params={"passes": 4, "finest_subpass_size": 2})
+    # this one takes about 11 s on this machine (five would exceed --max-request-mb: 422; so
+    # would four with patch votes, whose support adds two planes: medoid colours keep it).
+    heavy = busy.client.create_volume(exemplar=busy.exemplar_id, seed=3,
+                                      params={"passes": 4, "finest_subpass_size": 2, "color": "medoid"})
     cut = {"origin": [-900.5, 410.25, -33.5], "u": [0.8, 0, 0.6], "v": [0, 1, 0], "size": [160, 160]}
     with pytest.raises(requests.exceptions.ReadTimeout):
         requests.post(f"{busy.url}/v1/volumes/{heavy['id']}/cut", params={"timeout": "120"},

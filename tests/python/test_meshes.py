@@ -345,10 +345,11 @@ def test_surface_stats_dual_grid_and_plain(env):
             assert 0 < st["corrections"] == sum(lv["corrections"] for lv in levels), st
             assert math.isclose(st["fraction"], st["voxels_synthesized"] / st["bounding_voxels"],
                                 rel_tol=1e-6), st
-            # the repeat: every target voxel from the cache, nothing synthesized, same colors
+            # the repeat: every voxel the colors read (the support) from the cache, nothing
+            # synthesized, same colors
             st2 = again["stats"]
             assert st2["voxels_synthesized"] == 0 and st2["target_voxels"] == st["target_voxels"], st2
-            assert st2["levels"][-1]["cache_hits"] == st["target_voxels"], st2
+            assert st2["levels"][-1]["cache_hits"] == st["support_voxels"], st2
             assert_bits_equal(again["colors"], out["colors"], f"{scheme} {res}: cached repeat")
             results[scheme, res] = dict(st, colors=out["colors"])
     lo, hi = RES_STATS
