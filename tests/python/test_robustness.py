@@ -210,10 +210,10 @@ def test_line_shaped_cut_is_refused_by_the_cost_model_at_once(srv):
 
 def test_vote_colors_at_the_extremes_are_refused_or_answered_never_a_crash(srv):
     # patch votes read one step around the target (support_voxels), asked for explicitly on
-    # this grained exemplar (auto, the default, is vote too): a line-shaped cut and 140,000 scattered points are
-    # refused by the cost model at once, naming what sets their size; a stretched field (wider
-    # candidate offsets), a coarse dataset and a deadline answer 200, 200 and 504; the process
-    # stays up
+    # this grained exemplar (auto, the default, is vote too): a line-shaped cut and 140,000
+    # scattered points are refused by the cost model at once, naming what sets their size; a
+    # stretched field (wider candidate offsets), a coarse dataset and a deadline answer 200, 200
+    # and 504; the process stays up
     vid = create_volume(srv, params={"color": "vote"}).json()["id"]
     t0 = time.monotonic()
     err = assert_error(slice_of(srv, vid, size="4194304,1", timeout=5), 422, field_contains="size")
