@@ -1,6 +1,6 @@
 // Benchmark (diagnostic, issue #12): how coherent a cut's coordinate triples are, level by
 // level, and how far the three exemplar pixels of a finest triple agree. Prints one JSON object.
-//   bench_coherence TABLE.stx [--size N] [--typicality T] [--passes P] [--finest-subpass-size S]
+//   bench_coherence TABLE.stx [--size N] [--typicality auto|T] [--passes P] [--finest-subpass-size S]
 // A z cut N x N (default 128) at z = 0, identity field, default parameters otherwise (the
 // table's suggested plane weights), synthesized twice: as configured, and with no correction
 // at the finer levels (upsampling only: the coarsest level's result carried down). Per level:
@@ -15,6 +15,7 @@
 
 #include <cstring>
 #include <iostream>
+#include <optional>
 #include <string>
 
 #include "analysis/table_file.h"
@@ -29,10 +30,16 @@ namespace {
 struct Options {
   std::string table;
   int size = 128;
-  float typicality = SynthesisParams{}.typicality;
+  std::optional<float> typicality = SynthesisParams{}.typicality;  // absent: auto, per table
   int passes = SynthesisParams{}.passes;
   int finest_subpass_size = SynthesisParams{}.finest_subpass_size;
 };
+
+// "auto" is absent (resolved per table), anything else a weight.
+std::optional<float> typicality_arg(const std::string& s) {
+  if (s == "auto") return std::nullopt;
+  return float(std::atof(s.c_str()));
+}
 
 // Steps of each plane's coordinate when moving one voxel along world x or y (a z cut's axes):
 // plane k's first/second axes (types.h) are xy: (x, y), yz: (y, z), zx: (z, x).
@@ -127,17 +134,17 @@ int main(int argc, char** argv) {
     const std::string a = argv[i];
     const bool has_value = i + 1 < argc;
     if (a == "--size" && has_value) o.size = std::atoi(argv[++i]);
-    else if (a == "--typicality" && has_value) o.typicality = float(std::atof(argv[++i]));
+    else if (a == "--typicality" && has_value) o.typicality = typicality_arg(argv[++i]);
     else if (a == "--passes" && has_value) o.passes = std::atoi(argv[++i]);
     else if (a == "--finest-subpass-size" && has_value) o.finest_subpass_size = std::atoi(argv[++i]);
     else if (o.table.empty() && a.rfind("--", 0) != 0) o.table = a;
     else {
-      std::cerr << "usage: bench_coherence TABLE.stx [--size N] [--typicality T] [--passes P] [--finest-subpass-size S]\n";
+      std::cerr << "usage: bench_coherence TABLE.stx [--size N] [--typicality auto|T] [--passes P] [--finest-subpass-size S]\n";
       return 2;
     }
   }
   if (o.table.empty() || o.size < 8 || o.size > 1024) {
-    std::cerr << "usage: bench_coherence TABLE.stx [--size N (8..1024)] [--typicality T] [--passes P]\n";
+    std::cerr << "usage: bench_coherence TABLE.stx [--size N (8..1024)] [--typicality auto|T] [--passes P]\n";
     return 2;
   }
   auto table = load_table(o.table);
@@ -168,7 +175,7 @@ int main(int argc, char** argv) {
       return 1;
     }
     out[corrected ? "corrected" : "upsampled_only"] = {
-        {"passes", p.passes}, {"typicality", p.typicality}, {"finest_subpass_size", p.finest_subpass_size},
+        {"passes", p.passes}, {"typicality", resolved_typicality(**table, p.typicality)}, {"finest_subpass_size", p.finest_subpass_size},
         {"levels", measure(**table, (*synth)->cache(), o.size, normalised_weights(p.plane_weights))}};
   }
   std::cout << out.dump() << "\n";

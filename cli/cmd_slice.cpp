@@ -137,8 +137,10 @@ Status run_slice(const std::vector<std::string>& argv) {
     SOLIDTEX_ASSIGN_OR_RETURN(auto w, args.get_list("--plane-weights", 3));
     params.plane_weights = {float(w[0]), float(w[1]), float(w[2])};
   }
-  SOLIDTEX_ASSIGN_OR_RETURN(double typicality, args.get_double("--typicality", params.typicality, 0, 4));
-  params.typicality = float(typicality);
+  if (args.has("--typicality") && args.get("--typicality") != "auto") {  // absent or auto: per table
+    SOLIDTEX_ASSIGN_OR_RETURN(double typicality, args.get_double("--typicality", kTypicality, 0, 4));
+    params.typicality = float(typicality);
+  }
   SOLIDTEX_ASSIGN_OR_RETURN(double balance, args.get_double("--balance", params.balance, 0, 4));
   params.balance = float(balance);
   SOLIDTEX_RETURN_IF_ERROR(params.validate());

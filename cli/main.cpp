@@ -32,7 +32,7 @@ constexpr const char* kUsage =
     "  slice TABLE.stx (--axis x|y|z --at K [--origin U,V] | --plane OX,OY,OZ,UX,UY,UZ,VX,VY,VZ\n"
     "          [--resample auto|nearest|cubic])\n"
     "          --size W,H [--scheme plain|subpass|grid|dual-grid] [--field identity|quat:W,X,Y,Z|FILE]\n"
-    "          [--seed S] [--threads T] [--typicality 0.5] [--balance 1] [--init auto|scatter|slab] [--color auto|vote|medoid|mean]\n"
+    "          [--seed S] [--threads T] [--typicality auto|T] [--balance 1] [--init auto|scatter|slab] [--color auto|vote|medoid|mean]\n"
     "          [--finest-subpass-size 1|2] [--stats STATS.json] [--reference REF.png] -o OUT.png\n"
     "  field SKETCH.json -o FIELD.stf [--json]\n"
     "  serve [--host 127.0.0.1] [--port 8080] [--data DIR] [--threads N] [--queue N] [--deadline S]\n"

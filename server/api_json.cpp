@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <set>
 #include <string>
 #include <variant>
@@ -21,7 +22,9 @@ namespace {
 // validate() runs afterwards for the rules that involve several members.
 template <typename P>
 struct Param {
-  using Member = std::variant<int P::*, uint32_t P::*, float P::*, std::array<float, 3> P::*, Scheme P::*, Matcher P::*, Init P::*, ColorRule P::*>;
+  // std::optional<float>: a number in range, or "auto" for absent (resolved per table).
+  using Member = std::variant<int P::*, uint32_t P::*, float P::*, std::optional<float> P::*, std::array<float, 3> P::*,
+                              Scheme P::*, Matcher P::*, Init P::*, ColorRule P::*>;
   const char* key;
   Member member;
   int64_t lo = 0, hi = 0;
@@ -93,6 +96,16 @@ Status read_param(const Param<P>& d, const json& v, const std::string& field, P&
             p.*m = float(x);
             return Status::ok();
           },
+          [&](std::optional<float> P::*m) -> Status {
+            if (v.is_string() && v.get<std::string>() == "auto") {
+              p.*m = std::nullopt;
+              return Status::ok();
+            }
+            if (!v.is_number()) return Status(StatusCode::kInvalidArgument, "must be a number or \"auto\"", field);
+            SOLIDTEX_ASSIGN_OR_RETURN(double x, json_number(v, field, double(d.lo), double(d.hi)));
+            p.*m = float(x);
+            return Status::ok();
+          },
           [&](std::array<float, 3> P::*m) -> Status {
             if (!v.is_array() || v.size() != 3) return Status(StatusCode::kInvalidArgument, "must be 3 numbers", field);
             double largest = 0;
@@ -122,6 +135,7 @@ json write_params(const P& p, const Param<P> (&table)[N]) {
                                 [&](Matcher P::*m) { return json(matcher_name(p.*m)); },
                                 [&](Init P::*m) { return json(init_name(p.*m)); },
                                 [&](ColorRule P::*m) { return json(color_rule_name(p.*m)); },
+                                [&](std::optional<float> P::*m) { return p.*m ? json(*(p.*m)) : json("auto"); },
                                 [&](auto m) { return json(p.*m); },
                             },
                             d.member);

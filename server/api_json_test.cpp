@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include <fstream>
+#include <functional>
 #include <set>
 #include <sstream>
 #include <string>
@@ -32,7 +33,7 @@ TEST(ApiJson, WireFormatOfTheDefaults) {
             R"("suggested_plane_weights":[1.0,1.0,1.0]})");
   EXPECT_EQ(to_json(SynthesisParams{}).dump(),
             R"({"balance":1.0,"cell_size":12,"coarse_passes":3,"color":"auto","finest_subpass_size":1,"init":"auto","init_subpart":32,"matcher":"paper","passes":1,)"
-            R"("plane_weights":[1.0,1.0,1.0],"scheme":"dual-grid","subpass_size":2,"trilinear_levels":2,"typicality":0.5})");
+            R"("plane_weights":[1.0,1.0,1.0],"scheme":"dual-grid","subpass_size":2,"trilinear_levels":2,"typicality":"auto"})");
 }
 
 TEST(ApiJson, EveryKeyReadsBackWhatItWrites) {
@@ -67,6 +68,13 @@ TEST(ApiJson, EveryKeyReadsBackWhatItWrites) {
   EXPECT_EQ(s2->scheme, Scheme::kGrid);
   EXPECT_EQ(s2->plane_weights, s.plane_weights);
   EXPECT_EQ(s2->typicality, 1.25f);
+  // "auto" reads as absent over any base, and writes back as "auto"
+  SynthesisParams base;
+  base.typicality = 0.5f;
+  auto s3 = synthesis_params_from_json(json{{"typicality", "auto"}}, "params", base);
+  ASSERT_TRUE(s3.is_ok()) << s3.status().to_string();
+  EXPECT_FALSE(s3->typicality.has_value());
+  EXPECT_EQ(to_json(*s3)["typicality"], "auto");
 }
 
 TEST(ApiJson, MissingKeysKeepTheBase) {
@@ -108,7 +116,9 @@ TEST(ApiJson, ErrorsNameTheField) {
       {{{"init", "random"}}, "params.init", "unknown init 'random'"},
       {{{"color", "median"}}, "params.color", "unknown color 'median'"},
       {{{"typicality", 5}}, "params.typicality", "must be in [0.000000, 4.000000]"},
-      {{{"typicality", "high"}}, "params.typicality", "must be a number"},
+      {{{"typicality", "high"}}, "params.typicality", "must be a number or \"auto\""},
+      {{{"typicality", "0.5"}}, "params.typicality", "must be a number or \"auto\""},
+      {{{"typicality", nullptr}}, "params.typicality", "must be a number or \"auto\""},
   };
   for (const Case& c : synthesis) {
     const Status st = synthesis_error(c.j);
@@ -151,13 +161,11 @@ TEST(ApiJson, SynthesisParamsMatchTheVolumeSchema) {
   const json props = json::parse(text.str())["$defs"]["synthesisParams"]["properties"];
   const json defaults = to_json(SynthesisParams{});
   EXPECT_EQ(keys_of(props), keys_of(defaults));
-  for (auto it = props.begin(); it != props.end(); ++it) {
-    const std::string& key = it.key();
-    const json& prop = it.value();
-    if (prop.contains("default")) {
-      EXPECT_EQ(prop["default"], defaults[key]) << key;
-    }
-    if (prop["type"] == "integer") {
+  // A property's type, or each alternative of a oneOf (a number or "auto"), is tested alike.
+  std::function<void(const std::string&, const json&)> check = [&](const std::string& key, const json& prop) {
+    if (prop.contains("oneOf")) {
+      for (const json& alternative : prop["oneOf"]) check(key, alternative);
+    } else if (prop["type"] == "integer") {
       const int64_t lo = prop["minimum"], hi = prop["maximum"];
       EXPECT_TRUE(synthesis_error({{key, lo}}).is_ok()) << key << " = " << lo;
       EXPECT_TRUE(synthesis_error({{key, hi}}).is_ok()) << key << " = " << hi;
@@ -183,6 +191,12 @@ TEST(ApiJson, SynthesisParamsMatchTheVolumeSchema) {
     } else {
       ADD_FAILURE() << "untested schema property " << key;
     }
+  };
+  for (auto it = props.begin(); it != props.end(); ++it) {
+    if (it.value().contains("default")) {
+      EXPECT_EQ(it.value()["default"], defaults[it.key()]) << it.key();
+    }
+    check(it.key(), it.value());
   }
 }
 

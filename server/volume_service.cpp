@@ -575,7 +575,7 @@ bool pin_params(json& spec, const json& values) {
 // finest level ran 8 subpasses per pass, and usage penalties were not applied.
 json current_defaults() {
   const SynthesisParams d;
-  return {{"typicality", d.typicality},
+  return {{"typicality", d.typicality ? json(*d.typicality) : json("auto")},
           {"balance", d.balance},
           {"passes", d.passes},
           {"init", init_name(d.init)},

@@ -170,25 +170,31 @@ ColorRule resolved_color_rule(ColorRule rule) {
   return rule == ColorRule::kAuto ? ColorRule::kVote : rule;
 }
 
+float resolved_typicality(const Table& table, std::optional<float> typicality) {
+  if (typicality) return *typicality;
+  const ExemplarSet& e = table.exemplars();
+  return e.shared() || e.crossed() ? kTypicality : kThreePlaneTypicality;
+}
+
 CorrectionContext CorrectionContext::make(const Table& table, PyramidLevel l, const SynthesisParams& params) {
   CorrectionContext ctx;
   ctx.candidates_per_source = params.matcher == Matcher::kCoherent ? 4 : 64;
   ctx.cost_weights = params.plane_weights;
   ctx.color_weights = normalised_weights(params.plane_weights);
   ctx.color_rule = resolved_color_rule(params.color);
-  ctx.typicality = params.typicality;
+  ctx.typicality = resolved_typicality(table, params.typicality);
   ctx.level = &table.level(l);
   for (int k = 0; k < 3; ++k) {
     const PlaneAppearance& app = *ctx.level->planes[size_t(k)];
     const bool usage = params.balance > 0.f && !app.usage.empty();
-    if (!(params.typicality > 0.f) && !usage) continue;
+    if (!(ctx.typicality > 0.f) && !usage) continue;
     if (k > 0 && ctx.level->planes[size_t(k - 1)].get() == &app) {
       ctx.penalty[size_t(k)] = ctx.penalty[size_t(k - 1)];
       continue;
     }
     auto pen = std::make_shared<std::vector<float>>(app.typicality.size());
     for (size_t i = 0; i < pen->size(); ++i) {
-      float v = params.typicality * app.typicality[i];
+      float v = ctx.typicality * app.typicality[i];
       if (usage) v += params.balance * app.usage[i];
       (*pen)[i] = v;
     }

@@ -32,6 +32,7 @@
 #include <cmath>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "field/frame_field.h"
@@ -78,6 +79,11 @@ void output_color(const Table& table, const CoordinateTriple& t, const PlaneWeig
 // The rule `rule` stands for: kAuto is kVote on every table (one image, crossed, grain layouts:
 // README, Quality, "Grain layouts vote"). Other rules are themselves.
 ColorRule resolved_color_rule(ColorRule rule);
+// The typicality weight `typicality` stands for on `table`: itself when given; auto (absent)
+// is kThreePlaneTypicality on tables with three planes that are not the crossed layout (grain
+// layouts, three images: the slab-initialised solids of resolved_init), else kTypicality
+// (synthesis_params.h). A function of the table only, so voxels stay spatially deterministic.
+float resolved_typicality(const Table& table, std::optional<float> typicality);
 
 // Per-level constants of the correction, precomputed once per synthesizer.
 struct CorrectionContext {
@@ -91,7 +97,7 @@ struct CorrectionContext {
   int candidates_per_source = 64;                    // table candidates tried per source pixel
   PlaneWeights color_weights{1.f / 3, 1.f / 3, 1.f / 3};
   ColorRule color_rule = ColorRule::kMedoid;         // output colors only, resolved (never kAuto)
-  float typicality = 0.f;                            // SynthesisParams::typicality
+  float typicality = 0.f;                            // resolved_typicality()
   // Per plane, every exemplar pixel's penalty added to its match cost: typicality times its
   // typicality penalty plus balance times its usage penalty (float ops in that order); null
   // when both weights are 0 or there is nothing to weigh. Shared by planes sharing an image.

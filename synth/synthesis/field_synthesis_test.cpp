@@ -68,8 +68,9 @@ TEST(TensorFieldSynthesis, ConcentricCirclesMakeTangentialGrain) {
   auto table = grain_table(stripes, transposed(stripes));
   const int side = 72;
   // The median error of one cut moves by several degrees from seed to seed (seeds 1-5 with
-  // the end grain at 0.1: 9.6 / 11.0 / 6.4 / 9.2 / 6.4; at 0.3: 12.8 / 8.1 / 7.5 / 9.2 / 6.5),
-  // so the bound holds for the mean over three volume seeds, not for one.
+  // the end grain at 0.1: 9.6 / 11.0 / 6.4 / 9.2 / 6.4; at 0.3: 12.8 / 8.1 / 7.5 / 9.2 / 6.5;
+  // seeds 1-3 with three-plane typicality auto, 0.35: 9.9 / 8.1 / 7.8), so the bound holds for
+  // the mean over three volume seeds, not for one.
   double mean_median = 0;
   for (uint32_t seed : {1u, 2u, 3u}) {
     SynthesisParams sp = grain_params();

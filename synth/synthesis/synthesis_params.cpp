@@ -81,7 +81,7 @@ Status SynthesisParams::validate() const {
     total += w;
   }
   if (!(total > 0.f)) return Status(StatusCode::kInvalidArgument, "must not all be zero", "plane_weights");
-  if (!(typicality >= 0.f && typicality <= 4.f))
+  if (typicality && !(*typicality >= 0.f && *typicality <= 4.f))
     return Status(StatusCode::kInvalidArgument, "must be in [0, 4]", "typicality");
   if (!(balance >= 0.f && balance <= 4.f)) return Status(StatusCode::kInvalidArgument, "must be in [0, 4]", "balance");
   return Status::ok();

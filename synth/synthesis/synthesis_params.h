@@ -8,6 +8,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include "core/status.h"
@@ -59,6 +60,13 @@ const char* color_rule_name(ColorRule c);
 Result<Scheme> parse_scheme(const std::string& name);
 const char* scheme_name(Scheme s);
 
+// The typicality auto resolves to (resolved_typicality in correction.h): one image and the
+// crossed layout (isotropic solids) take kTypicality; three planes (grain layouts, three
+// images) take kThreePlaneTypicality, measured best there (README, Quality, "Grain layouts
+// match less typically").
+inline constexpr float kTypicality = 0.5f;
+inline constexpr float kThreePlaneTypicality = 0.35f;
+
 struct SynthesisParams {
   Scheme scheme = Scheme::kDualGrid;
   Matcher matcher = Matcher::kPaper;
@@ -90,8 +98,10 @@ struct SynthesisParams {
   // Weight of the typicality penalty in matching costs (analysis/typicality.h), [0, 4]: how
   // hard matches are pulled away from the exemplar's mean appearance. 0 is plain L2 matching
   // (Zhang et al.), whose slices collapse into smooth blobs; 0.5 keeps pebbles, veins and
-  // weave crisp (bench/bench_quality.py); much above 1 favours extremes and noise.
-  float typicality = 0.5f;
+  // weave crisp (bench/bench_quality.py); much above 1 favours extremes and noise. Absent is
+  // auto, the default: resolved_typicality() (correction.h) picks per table. Volumes pin it;
+  // volumes stored before auto keep the 0.5 they pinned.
+  std::optional<float> typicality;
   // Weight of the table's usage penalties in matching costs (synthesis/usage_balance.h), [0, 4]:
   // 1 applies them as calibrated (exemplar regions the matching over-uses cost more, regions
   // it neglects less: Kopf et al.'s histogram matching as a fixed function of the table);

@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <optional>
+#include <tuple>
 
 #include "analysis/analysis.h"
 #include "analysis/exemplar.h"
@@ -415,7 +417,7 @@ TEST(SynthesizerQuality, CutsAreCrispAndCoverTheExemplarUnlikeABlurredCopy) {
   const ImageF window = toroidal_crop(exemplar, 5, 9, 40, 40);
   const double blur_sharp = sharpness_ratio(gaussian_blur(window, 1.0), exemplar);
   const double blur_coverage = coverage(gaussian_blur(window, 2.0), exemplar, 7, 2);
-  auto scores = [&](float typicality, double& cov, double& min_sharp, double& max_sharp) {
+  auto scores = [&](std::optional<float> typicality, double& cov, double& min_sharp, double& max_sharp) {
     SynthesisParams p = small_params();
     p.typicality = typicality;
     auto s = make(table, "identity", p, 0);
@@ -528,6 +530,44 @@ void expect_votes_copy_patches(ProceduralKind kind, bool grain_x, double min_gai
               grain_x ? "grain x" : "one image", cont[0], cont[1], sharp[0], sharp[1]);
   EXPECT_GT(cont[1], min_gain * cont[0]) << (grain_x ? "grain x" : "one image");
   EXPECT_GT(sharp[1], 0.9 * sharp[0]) << (grain_x ? "grain x" : "one image");
+}
+
+// Typicality auto (the default) is a function of the table's layout: three planes (grain
+// layouts, three images) take kThreePlaneTypicality, one image and the crossed layout
+// kTypicality; a given weight is itself. End to end: a default synthesizer's cut is the
+// resolved weight's, bit for bit, and not the other weight's.
+TEST(SynthesizerTypicality, AutoTakesTheThreePlaneWeightOnGrainTablesOnly) {
+  const auto grain = small_table(ProceduralKind::kWood, true);
+  const auto one = small_table(ProceduralKind::kWood, false);
+  ExemplarInputs in;
+  in.xy = testing::procedural(ProceduralKind::kWood, 48, 48);
+  std::array<float, 3> weights{};
+  ASSERT_EQ(apply_grain_layout("crossed", in, weights).value(), "crossed");
+  AnalysisParams ap;
+  ap.levels = 3;
+  ap.neighborhood = 7;
+  ap.candidates = 8;
+  ap.pca_dims = 12;
+  const auto crossed = analyze(ExemplarSet::create(std::move(in)).value(), ap).value().table;
+  ASSERT_TRUE(crossed->exemplars().crossed());
+  EXPECT_EQ(resolved_typicality(*grain, std::nullopt), kThreePlaneTypicality);
+  EXPECT_EQ(resolved_typicality(*one, std::nullopt), kTypicality);
+  EXPECT_EQ(resolved_typicality(*crossed, std::nullopt), kTypicality);
+  EXPECT_EQ(resolved_typicality(*grain, 1.5f), 1.5f);
+  EXPECT_EQ(resolved_typicality(*one, 0.f), 0.f);
+  EXPECT_NE(kTypicality, kThreePlaneTypicality);
+
+  for (const auto& [table, resolved, other] : {std::tuple{grain, kThreePlaneTypicality, kTypicality},
+                                               std::tuple{one, kTypicality, kThreePlaneTypicality}}) {
+    auto with = [&](std::optional<float> t) {
+      SynthesisParams p = small_params();
+      p.typicality = t;
+      return cut(*make(table, "identity", p, 0), 'x', 3, 0, 0, 24, 24);
+    };
+    const auto by_default = with(SynthesisParams{}.typicality);
+    EXPECT_EQ(by_default, with(resolved));
+    EXPECT_NE(by_default, with(other));
+  }
 }
 
 TEST(SynthesizerQuality, VoteColorsCopyExemplarPatchesWhereMedoidsMakeAMosaic) {

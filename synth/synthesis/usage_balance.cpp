@@ -148,6 +148,9 @@ Result<std::shared_ptr<const Table>> balance_usage(std::shared_ptr<const Table> 
   // for one image) would also synthesize a ring around the block and count it, changing every
   // table analysed since, and cost time.
   calibration.color = ColorRule::kMedoid;
+  // Calibration predates typicality auto and measured its gains at this weight on every table;
+  // pinned so that tables analysed before auto and after are the same.
+  calibration.typicality = kTypicality;
   for (int round = 0; round < params.rounds; ++round) {
     SOLIDTEX_ASSIGN_OR_RETURN(auto current, table->with_usage(usage));
     ShareInterrupter share(interrupter, round, params.rounds);

@@ -128,38 +128,41 @@ def test_volumes_stored_before_a_default_changed_keep_their_voxels(server, exemp
     passes, init, color, finest_subpass_size, balance); a volume.json written before those were
     pinned (none anywhere) comes back with the values its voxels were synthesized with
     (typicality 0, two passes, slab init, mean colors, 8 finest subpasses, no usage balance),
-    and one written at each later era (typicality and passes pinned; then init; then color;
-    then finest_subpass_size) with the older values of the keys it lacks: no release changes a
-    stored volume's look."""
+    and one written at each later era (typicality, 0.5 until auto, and passes pinned; then init;
+    then color; then finest_subpass_size) with the older values of the keys it lacks: no release
+    changes a stored volume's look."""
     a = server()
     c = a.client
     ex = upload_ready(c, exemplars["spots"])
     vol = c.create_volume(exemplar=ex["id"], seed=4)
-    assert vol["params"] == {"typicality": 0.5, "passes": 1, "init": "auto", "color": "auto", "finest_subpass_size": 1,
+    assert vol["params"] == {"typicality": "auto", "passes": 1, "init": "auto", "color": "auto", "finest_subpass_size": 1,
                              "balance": 1.0}, vol
+    # typicality auto is 0.5 on one image (on three planes 0.35: test_robustness.py)
+    half = c.create_volume(exemplar=ex["id"], seed=4, params={"typicality": 0.5})
+    assert np.array_equal(c.slice(vol["id"], "z", 2, (24, 24)), c.slice(half["id"], "z", 2, (24, 24)))
     legacy = c.create_volume(exemplar=ex["id"], seed=4, params={"typicality": 0, "passes": 2, "init": "slab", "color": "mean",
                                                                     "finest_subpass_size": 2, "balance": 0})
     want = c.slice(legacy["id"], "z", 2, (24, 24))
     assert not np.array_equal(c.slice(vol["id"], "z", 2, (24, 24)), want), "the defaults changed nothing"
-    # made when typicality and passes were pinned but init was not
-    middle = c.create_volume(exemplar=ex["id"], seed=5)
+    # made when typicality (0.5, before auto) and passes were pinned but init was not
+    middle = c.create_volume(exemplar=ex["id"], seed=5, params={"typicality": 0.5})
     slab = c.create_volume(exemplar=ex["id"], seed=5, params={"init": "slab", "color": "mean", "finest_subpass_size": 2,
                                                                 "balance": 0})
     want_middle = c.slice(slab["id"], "z", 2, (24, 24))
     assert not np.array_equal(c.slice(middle["id"], "z", 2, (24, 24)), want_middle), "init changed nothing"
     # made when init was pinned but color was not
-    late = c.create_volume(exemplar=ex["id"], seed=6)
+    late = c.create_volume(exemplar=ex["id"], seed=6, params={"typicality": 0.5})
     mean = c.create_volume(exemplar=ex["id"], seed=6, params={"color": "mean", "finest_subpass_size": 2, "balance": 0})
     want_late = c.slice(mean["id"], "z", 2, (24, 24))
     assert not np.array_equal(c.slice(late["id"], "z", 2, (24, 24)), want_late), "color changed nothing"
     # made when color was pinned but finest_subpass_size was not
     # (color was medoid by default then; it is pinned, so a later default changes nothing stored)
-    recent = c.create_volume(exemplar=ex["id"], seed=7, params={"color": "medoid"})
+    recent = c.create_volume(exemplar=ex["id"], seed=7, params={"typicality": 0.5, "color": "medoid"})
     eight = c.create_volume(exemplar=ex["id"], seed=7, params={"color": "medoid", "finest_subpass_size": 2, "balance": 0})
     want_recent = c.slice(eight["id"], "z", 2, (24, 24))
     assert not np.array_equal(c.slice(recent["id"], "z", 2, (24, 24)), want_recent), "subpasses changed nothing"
     # made when finest_subpass_size was pinned but balance was not
-    newest = c.create_volume(exemplar=ex["id"], seed=8, params={"color": "medoid"})
+    newest = c.create_volume(exemplar=ex["id"], seed=8, params={"typicality": 0.5, "color": "medoid"})
     unbalanced = c.create_volume(exemplar=ex["id"], seed=8, params={"color": "medoid", "balance": 0})
     want_newest = c.slice(unbalanced["id"], "z", 2, (24, 24))
     assert not np.array_equal(c.slice(newest["id"], "z", 2, (24, 24)), want_newest), "balance changed nothing"

@@ -75,6 +75,14 @@ def test_typicality_at_its_documented_extremes(srv):
     weight_at_its_documented_extremes(srv, "typicality")
 
 
+def test_typicality_auto_is_the_three_plane_weight_on_a_grained_exemplar(srv):
+    # auto (the default, pinned when absent) resolves per table: the procedural wood is
+    # analysed as grain x (three planes), where it is 0.35 (on one image 0.5: test_persistence.py)
+    cuts = takes_its_values_only(srv, "typicality", ("auto", 0.35, 0.5), "auto", ("Auto", "", "0.35", {"auto": 1}))
+    assert cuts["auto"] == cuts[0.35]
+    assert cuts["auto"] != cuts[0.5]
+
+
 def test_balance_at_its_documented_extremes(srv):
     # the two extremes differ: the exemplar's table has usage penalties
     cuts = weight_at_its_documented_extremes(srv, "balance")

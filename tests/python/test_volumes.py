@@ -314,7 +314,7 @@ def test_old_scheme_name_is_rejected_and_plain_works(shared, tmp_path):
             "--seed", "7", "--scheme", "plain", "-o", out)
     assert np.array_equal(file_pixels(out), png_pixels(png)), "service plain != CLI --scheme plain"
     # the default scheme, dual-grid; the typicality, passes, init, color, subpass and balance defaults are pinned into the stored params
-    assert shared.volume["params"] == {"typicality": 0.5, "passes": 1, "init": "auto", "color": "auto", "finest_subpass_size": 1,
+    assert shared.volume["params"] == {"typicality": "auto", "passes": 1, "init": "auto", "color": "auto", "finest_subpass_size": 1,
                                        "balance": 1.0}, shared.volume
     default = c.slice(shared.volume_id, "z", 3, (32, 24))
     assert not np.array_equal(png_pixels(png), default), "plain and dual-grid gave the same slice"
