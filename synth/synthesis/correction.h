@@ -83,6 +83,7 @@ ColorRule resolved_color_rule(ColorRule rule);
 // is kThreePlaneTypicality on tables with three planes that are not the crossed layout (grain
 // layouts, three images: the slab-initialised solids of resolved_init), else kTypicality
 // (synthesis_params.h). A function of the table only, so voxels stay spatially deterministic.
+// Stored volumes pin "auto", so this rule is part of their look: a new rule needs a new name.
 float resolved_typicality(const Table& table, std::optional<float> typicality);
 
 // Per-level constants of the correction, precomputed once per synthesizer.
