@@ -77,7 +77,9 @@ void matching_color(const TableLevel& level, const CoordinateTriple& t, int chan
 // `w` are normalised weights (not all zero).
 void output_color(const Table& table, const CoordinateTriple& t, const PlaneWeights& w, ColorRule rule, float rgb[3]);
 // The rule `rule` stands for: kAuto is kVote on every table (one image, crossed, grain layouts:
-// README, Quality, "Grain layouts vote"). Other rules are themselves.
+// README, Quality, "Grain layouts vote"). Other rules are themselves. Stored volumes pin
+// "auto", so this rule is part of their look (it changed once, for three-plane tables, from
+// medoid to vote): a new rule needs a new name.
 ColorRule resolved_color_rule(ColorRule rule);
 // The typicality weight `typicality` stands for on `table`: itself when given; auto (absent)
 // is kThreePlaneTypicality on tables with three planes that are not the crossed layout (grain
