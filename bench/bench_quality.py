@@ -74,8 +74,10 @@ def dominant_orientation(path: Path) -> tuple[float, float]:
     return 0.5 * float(np.arctan2(2 * jxy, jxx - jyy)), coherence
 
 
-def oriented_reference(exemplar: Path, cut: Path, out: Path, size: int = 512) -> dict:
-    """The exemplar turned so its dominant orientation is the cut's, SIZE^2, sampled cubically
+def oriented_reference(exemplar: Path, exemplar_orientation: tuple[float, float], cut: Path, out: Path,
+                       size: int = 512) -> dict:
+    """The exemplar (its dominant_orientation given: one per exemplar, not per cut) turned so
+    its dominant orientation is the cut's, SIZE^2, sampled cubically
     and periodically (texmetric treats the exemplar as periodic too). Why: a grained solid is
     made of sheets whose tilt synthesis chooses (README, Quality, "How the grained solids are
     built"), so an oblique cut shows the grain turned by an angle no layout fixes beforehand,
@@ -83,7 +85,7 @@ def oriented_reference(exemplar: Path, cut: Path, out: Path, size: int = 512) ->
     the reference a little (a 0.3 degree turn of tree_bark lowers its z cut's swd 0.111 ->
     0.100), so compare these scores with each other, not with the others."""
     from scipy.ndimage import map_coordinates
-    ex_angle, ex_coherence = dominant_orientation(exemplar)
+    ex_angle, ex_coherence = exemplar_orientation
     cut_angle, cut_coherence = dominant_orientation(cut)
     turn = cut_angle - ex_angle
     e = np.asarray(Image.open(exemplar).convert("RGB"), dtype=np.float64)
@@ -95,6 +97,12 @@ def oriented_reference(exemplar: Path, cut: Path, out: Path, size: int = 512) ->
     Image.fromarray(np.clip(ref, 0, 255).round().astype(np.uint8)).save(out)
     return {"turn_deg": round(float(np.degrees(turn)), 1), "cut_coherence": round(cut_coherence, 3),
             "exemplar_coherence": round(ex_coherence, 3)}
+
+
+def oblique_over_axis(cuts_by_seed: list[dict], score=lambda c: c["swd"]) -> float:
+    """Mean oblique swd over mean axis-cut swd, over seeds; `score` picks which swd of a cut."""
+    axis = np.mean([score(s[c]) for s in cuts_by_seed for c in ("z", "y", "x")])
+    return round(float(np.mean([score(s["oblique"]) for s in cuts_by_seed])) / float(axis), 3)
 
 
 def embark_binary(build: Path) -> Path | None:
@@ -177,6 +185,7 @@ def main() -> int:
                     "x": ["--axis", "x", "--at", "0"], "oblique": ["--plane", OBLIQUE, "--resample", args.resample]}
             entry = {"exemplar": name, "grain": "x" if name in GRAIN_X else "", "analyze_args": [] if name in GRAIN_X else grain, "size": n, "seeds": {}}
             images = [ex]
+            ex_orientation = dominant_orientation(ex) if args.oriented else None
             for seed in seeds:
                 per_seed = {}
                 for cut, where in cuts.items():
@@ -199,7 +208,7 @@ def main() -> int:
                         scores["as_given"] = texmetric(python, image, ex)
                     if args.oriented:
                         oriented = tmp / f"{name}_{cut}_oriented.png"
-                        turn = oriented_reference(ex, image, oriented)
+                        turn = oriented_reference(ex, ex_orientation, image, oriented)
                         scores["oriented"] = {**texmetric(python, image, oriented), **turn}
                     scores["seconds"] = round(seconds, 2)
                     st = json.loads(stats.read_text())
@@ -230,12 +239,9 @@ def main() -> int:
                 entry["worst_swd_over_embark"] = round(entry["worst_swd_mean_over_seeds"] / entry["embark"]["swd"], 3)
                 entry["worst_swd_as_given_over_embark"] = round(entry["worst_swd_as_given_mean_over_seeds"] / entry["embark"]["swd"], 3)
             cuts_all = list(entry["seeds"].values())
-            axis_mean = np.mean([s[c]["swd"] for s in cuts_all for c in ("z", "y", "x")])
-            entry["oblique_over_axis_swd"] = round(float(np.mean([s["oblique"]["swd"] for s in cuts_all])) / axis_mean, 3)
+            entry["oblique_over_axis_swd"] = oblique_over_axis(cuts_all)
             if args.oriented:  # the same with every cut against its oriented reference
-                axis_oriented = np.mean([s[c]["oriented"]["swd"] for s in cuts_all for c in ("z", "y", "x")])
-                entry["oblique_over_axis_swd_oriented"] = round(
-                    float(np.mean([s["oblique"]["oriented"]["swd"] for s in cuts_all])) / axis_oriented, 3)
+                entry["oblique_over_axis_swd_oriented"] = oblique_over_axis(cuts_all, lambda c: c["oriented"]["swd"])
             montage(images, out_dir / f"{name}_montage.png")
             results.append(entry)
             print(f"{name}: " + " ".join(f"{c}={v['swd']:.3f}/{v['sharp']:.2f}" for c, v in entry["cuts"].items())
