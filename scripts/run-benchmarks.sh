@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Runs every benchmark in bench/ and prints one JSON document:
 #   {"analysis": [...], "slice": {...}, "coherence": {...}, "field": {...}, "surface": {...},
-#    "service": {...}, "arrays": {...}, "quality": {...}, "rss": {...}}. Takes about two hours on 2 cores (QUALITY_SIZE=128 for a quicker
+#    "service": {...}, "arrays": {...}, "quality": {...}, "reference_solids": {...}, "rss": {...}}. Takes about two hours on 2 cores (QUALITY_SIZE=128 for a quicker
 #    quality run; RSS_QUICK=1 for smaller memory probes).
 # Uses ../shared/data/exemplars/wood_grain.png when present, else a procedural wood exemplar.
 set -euo pipefail
@@ -43,6 +43,8 @@ echo ', "arrays":'
 "$build/venv/bin/python" "$(dirname "$0")/../bench/bench_arrays.py" "$build"
 echo ', "quality":'
 "$build/venv/bin/python" "$(dirname "$0")/../bench/bench_quality.py" "$build" --size "${QUALITY_SIZE:-256}"
+echo ', "reference_solids":'
+"$build/venv/bin/python" "$(dirname "$0")/../bench/bench_reference_solids.py" --size "${QUALITY_SIZE:-256}" 2>/dev/null
 echo ', "rss":'
 "$build/venv/bin/python" "$(dirname "$0")/../bench/bench_rss.py" "$build" --cache-mb "${RSS_CACHE_MB:-256}" \
   ${RSS_QUICK:+--quick} 2>/dev/null

@@ -1,0 +1,151 @@
+#!/usr/bin/env python3
+"""Reference solids for the grain layouts (issue 12): what simple, perfectly coherent solids
+built from a striped exemplar score on bench_quality's four cuts, scored the same way.
+
+  bench_reference_solids.py [--size 256] [--exemplars a.png:x,b.png:y] [--embark-cache F]
+
+A grain layout (`solidtex analyze --grain x|y`) asks two planes for the stripes and the third
+for the end grain, an image of E, too. No solid meets all three: bench_quality's README section
+argues it; this measures it. Each reference solid copies one exemplar pixel per voxel through
+a linear map of world (x, y, z) to exemplar (column, row), so it is a voxel solid synthesis could
+in principle produce, with the stripes perfectly coherent in 3D (E's stripes run along its
+columns for grain x, along its rows for grain y; `u` is the coordinate along them, `a` the one
+across):
+
+  extruded      E extruded along z: a = the across axis of the xy plane. Ideal z cut only.
+  sheets+45     sheets tilted 45 degrees between the two striped planes: a = across + z.
+                Both striped cuts show E exactly; the end grain shows diagonal stripes.
+  sheets-45     the other tilt: a = across - z.
+  sheets+45/√2  sheets+45 with E's stripe spacing measured along the sheets' normal:
+                a = (across + z)/√2; every axis cut shows stripes √2 wider.
+  layers        sheets normal to z: a = z. The z cut is one stripe's colour.
+
+Cuts and references are bench_quality's: z (xy plane, x right, y down), y (x right, z down), x
+(y right, z down), each scored against the image its plane gets under the layout, oriented as the
+cut (E, or E transposed where the grain runs across the cut); the oblique (bench_quality.OBLIQUE)
+against E. Pixels are nearest (one exemplar pixel per voxel), so no cut is smoothed.
+
+Prints one JSON document: per exemplar and solid, each cut's texmetric scores, the worst of the
+four cuts' swd (over Embark's when --embark-cache, bench_quality's file, holds the exemplar) and
+oblique / axis. Needs ../shared/tools/texmetric.py; default exemplars: the four shared grained
+ones with the layouts `--grain auto` gives them.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+from PIL import Image
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from bench_quality import OBLIQUE, SHARED, oblique_over_axis, texmetric  # noqa: E402
+
+DEFAULT_EXEMPLARS = "wood_grain.png:x,wood_planks.png:x,stripes_dunes.png:x,tree_bark.png:y"
+CUT_AXES = {  # pixel (i, j) of a cut is origin + i * u + j * v
+    "z": ((1, 0, 0), (0, 1, 0)),
+    "y": ((1, 0, 0), (0, 0, 1)),
+    "x": ((0, 1, 0), (0, 0, 1)),
+}
+SQRT2 = float(np.sqrt(2.0))
+
+
+def solid_maps(grain: str) -> dict:
+    """Solid name -> f(x, y, z) -> (exemplar column, exemplar row), for a layout of `grain`.
+    Grain x: E's stripes run along its columns' axis (x), across = y; grain y: across = x."""
+    def laid(across_of):
+        if grain == "x":
+            return lambda x, y, z: (x, across_of(y, z))
+        return lambda x, y, z: (across_of(x, z), y)
+    return {
+        "extruded": laid(lambda across, z: across),
+        "sheets+45": laid(lambda across, z: across + z),
+        "sheets-45": laid(lambda across, z: across - z),
+        "sheets+45/√2": laid(lambda across, z: (across + z) / SQRT2),
+        "layers": laid(lambda across, z: z),
+    }
+
+
+def cut_references(exemplar: np.ndarray, grain: str) -> dict:
+    """The image each axis cut is judged against (bench_quality, `solidtex slice --reference`):
+    grain x lays xy = E, zx = E transposed, yz = E (end grain); grain y lays xy = E, yz = E
+    transposed, zx = E (end grain). Axis y shows zx transposed; so grain x's y cut and x cut are
+    judged against E, grain y's against E transposed."""
+    across = exemplar.transpose(1, 0, 2)
+    if grain == "x":
+        return {"z": exemplar, "y": exemplar, "x": exemplar, "oblique": exemplar}
+    return {"z": exemplar, "y": across, "x": across, "oblique": exemplar}
+
+
+def render_cut(exemplar: np.ndarray, solid, u, v, size: int, origin=(0.0, 0.0, 0.0)) -> np.ndarray:
+    h, w, _ = exemplar.shape
+    i, j = np.meshgrid(np.arange(size, dtype=np.float64), np.arange(size, dtype=np.float64))
+    # Voxels first (a cut samples the nearest voxel), then the voxel's exemplar pixel.
+    x, y, z = (np.rint(origin[k] + i * u[k] + j * v[k]) for k in range(3))
+    col, row = solid(x, y, z)
+    return exemplar[np.rint(row).astype(np.int64) % h, np.rint(col).astype(np.int64) % w]
+
+
+def score_solid(python: str, exemplar: np.ndarray, grain: str, solid, size: int, tmp: Path, name: str) -> dict:
+    oblique = [float(c) for c in OBLIQUE.split(",")]
+    axes = dict(CUT_AXES, oblique=(tuple(oblique[3:6]), tuple(oblique[6:9])))
+    references = cut_references(exemplar, grain)
+    cuts = {}
+    for cut, (u, v) in axes.items():
+        image, reference = tmp / f"{name}_{cut}.png", tmp / f"{name}_{cut}_reference.png"
+        Image.fromarray(render_cut(exemplar, solid, u, v, size, tuple(oblique[0:3]))).save(image)
+        Image.fromarray(references[cut]).save(reference)
+        cuts[cut] = texmetric(python, image, reference)
+    return cuts
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--size", type=int, default=256)
+    ap.add_argument("--exemplars", default=DEFAULT_EXEMPLARS,
+                    help="comma-separated PATH:GRAIN (grain x or y); bare names are looked up in ../shared/data/exemplars")
+    ap.add_argument("--embark-cache", type=Path, help="bench_quality's Embark scores file, for worst / Embark")
+    ap.add_argument("--keep", type=Path, help="keep the cuts' PNGs in this directory")
+    args = ap.parse_args()
+    if not (SHARED / "tools" / "texmetric.py").is_file():
+        print(f"bench_reference_solids: {SHARED / 'tools' / 'texmetric.py'} not found", file=sys.stderr)
+        return 2
+    embark = json.loads(args.embark_cache.read_text()) if args.embark_cache and args.embark_cache.is_file() else {}
+    out = []
+    with tempfile.TemporaryDirectory() as scratch:
+        tmp = args.keep or Path(scratch)
+        tmp.mkdir(parents=True, exist_ok=True)
+        for spec in args.exemplars.split(","):
+            path_text, _, grain = spec.rpartition(":")
+            if grain not in ("x", "y"):
+                ap.error(f"--exemplars: {spec!r} needs a grain, PATH:x or PATH:y")
+            path = Path(path_text)
+            if not path.is_file():
+                path = SHARED / "data" / "exemplars" / path_text
+            exemplar = np.asarray(Image.open(path).convert("RGB"))
+            entry = {"exemplar": path.stem, "grain": grain, "size": args.size, "solids": {}}
+            reference = embark.get(f"{path.stem}@{args.size}", {}).get("swd")
+            for solid_name, solid in solid_maps(grain).items():
+                cuts = score_solid(sys.executable, exemplar, grain, solid, args.size, tmp, f"{path.stem}_{solid_name.replace('/', '_')}")
+                worst = max(c["swd"] for c in cuts.values())
+                entry["solids"][solid_name] = {
+                    "cuts": cuts,
+                    "worst_swd": round(worst, 4),
+                    "worst_swd_over_embark": round(worst / reference, 3) if reference else None,
+                    "oblique_over_axis_swd": oblique_over_axis([cuts]),
+                }
+                print(f"{path.stem} grain {grain} {solid_name}: " + " ".join(f"{c}={cuts[c]['swd']:.3f}" for c in cuts)
+                      + f" worst={worst:.3f}", file=sys.stderr)
+            best = min(entry["solids"], key=lambda s: entry["solids"][s]["worst_swd"])
+            entry["best_worst_swd"] = {"solid": best, "swd": entry["solids"][best]["worst_swd"],
+                                       "over_embark": entry["solids"][best]["worst_swd_over_embark"]}
+            out.append(entry)
+    print(json.dumps({"size": args.size, "exemplars": out}, indent=1, ensure_ascii=False))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

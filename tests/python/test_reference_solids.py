@@ -1,0 +1,64 @@
+"""bench/bench_reference_solids.py: its solids are the 3D stripes they claim, its cuts are
+bench_quality's, and texmetric sees what the geometry says (the end grain cannot match)."""
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+BENCH = Path(__file__).resolve().parents[2] / "bench"
+sys.path.insert(0, str(BENCH))
+import bench_reference_solids as refs  # noqa: E402
+
+
+def striped_exemplar(across_rows: bool) -> np.ndarray:
+    """32x24 RGB stripes of period 8 that vary down the rows (grain x) or across the columns
+    (grain y), with per-pixel noise so that no two stripes' pixels are alike."""
+    rng = np.random.default_rng(7)
+    rows, cols = np.mgrid[0:24, 0:32]
+    across = rows if across_rows else cols
+    base = 128 + 90 * np.sin(2 * np.pi * across / 8.0)
+    image = np.stack([base, 0.6 * base + 40, 255 - base], -1) + rng.normal(0, 12, (24, 32, 3))
+    return np.clip(image, 0, 255).astype(np.uint8)
+
+
+def tiled(image: np.ndarray, size: int) -> np.ndarray:
+    h, w, _ = image.shape
+    return np.tile(image, (size // h + 1, size // w + 1, 1))[:size, :size]
+
+
+@pytest.mark.parametrize("grain", ["x", "y"])
+def test_tilted_sheets_show_the_exemplar_on_both_striped_cuts_and_not_on_the_end_grain(grain):
+    e = striped_exemplar(across_rows=grain == "x")
+    sheets = refs.solid_maps(grain)["sheets+45"]
+    references = refs.cut_references(e, grain)
+    # The two striped planes: grain x stripes xy (z cut) and zx (y cut), grain y xy and yz (x cut).
+    striped = ["z", "y"] if grain == "x" else ["z", "x"]
+    end_grain = "x" if grain == "x" else "y"
+    for cut in striped:
+        u, v = refs.CUT_AXES[cut]
+        image = refs.render_cut(e, sheets, u, v, 48)
+        # The cut is the reference shifted (periodically): some offset matches it pixel for pixel.
+        ref = references[cut]
+        h, w, _ = ref.shape
+        assert any(np.array_equal(image, tiled(np.roll(ref, (dy, dx), (0, 1)), 48)) for dy in range(h) for dx in range(w)), cut
+    u, v = refs.CUT_AXES[end_grain]
+    end = refs.render_cut(e, sheets, u, v, 48)
+    # The end grain's stripes run diagonally: constant along one diagonal, not along the rows.
+    assert np.array_equal(end[1:, :-1], end[:-1, 1:])
+    assert not np.array_equal(end[:, 1:], end[:, :-1])
+
+def test_texmetric_scores_the_end_grain_of_sheets_far_from_their_striped_cuts(tmp_path):
+    if not (refs.SHARED / "tools" / "texmetric.py").is_file():
+        pytest.skip(f"{refs.SHARED / 'tools' / 'texmetric.py'} not found: needs ../shared")
+    e = striped_exemplar(across_rows=True)
+    sheets = refs.score_solid(sys.executable, e, "x", refs.solid_maps("x")["sheets+45"], 64, tmp_path, "sheets")
+    extruded = refs.score_solid(sys.executable, e, "x", refs.solid_maps("x")["extruded"], 64, tmp_path, "extruded")
+    assert sheets["z"]["swd"] < 0.15 and sheets["y"]["swd"] < 0.15, sheets
+    assert sheets["x"]["swd"] > 2 * max(sheets["z"]["swd"], sheets["y"]["swd"]), sheets
+    # Extruded along z, the y cut is one stripe colour per row: the stripes are gone.
+    assert extruded["y"]["swd"] > 2 * extruded["z"]["swd"], extruded
+    assert Image.open(tmp_path / "sheets_oblique.png").size == (64, 64)
