@@ -5,8 +5,8 @@ built from a striped exemplar score on bench_quality's four cuts, scored the sam
   bench_reference_solids.py [--size 256] [--exemplars a.png:x,b.png:y] [--embark-cache F]
 
 A grain layout (`solidtex analyze --grain x|y`) asks two planes for the stripes and the third
-for the end grain, an image of E, too. No solid meets all three: bench_quality's README section
-argues it; this measures it. Each reference solid copies one exemplar pixel per voxel through
+for the end grain, an image of E, too. No solid meets all three (README, Quality, "How the
+grained solids are built"); this measures how close simple coherent solids come. Each reference solid copies one exemplar pixel per voxel through
 a linear map of world (x, y, z) to exemplar (column, row), so it is a voxel solid synthesis could
 in principle produce, with the stripes perfectly coherent in 3D (E's stripes run along its
 columns for grain x, along its rows for grain y; `u` is the coordinate along them, `a` the one
