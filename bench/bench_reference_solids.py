@@ -6,19 +6,20 @@ built from a striped exemplar score on bench_quality's four cuts, scored the sam
 
 A grain layout (`solidtex analyze --grain x|y`) asks two planes for the stripes and the third
 for the end grain, an image of E, too. No solid meets all three (README, Quality, "How the
-grained solids are built"); this measures how close simple coherent solids come. Each reference solid copies one exemplar pixel per voxel through
-a linear map of world (x, y, z) to exemplar (column, row), so it is a voxel solid synthesis could
-in principle produce, with the stripes perfectly coherent in 3D (E's stripes run along its
-columns for grain x, along its rows for grain y; `u` is the coordinate along them, `a` the one
-across):
+grained solids are built"); this measures how close simple coherent solids come. Each
+reference solid copies one exemplar pixel per voxel through a linear map of world (x, y, z) to
+exemplar (column, row), so it is a voxel solid synthesis could in principle produce, with the
+stripes perfectly coherent in 3D. E's stripes run along its columns for grain x, along its rows
+for grain y; `across` is the world axis of the xy plane that crosses them (y for grain x, x for
+grain y), and each solid says which exemplar coordinate across the stripes a voxel reads:
 
-  extruded      E extruded along z: a = the across axis of the xy plane. Ideal z cut only.
-  sheets+45     sheets tilted 45 degrees between the two striped planes: a = across + z.
+  extruded      E extruded along z: across. Ideal z cut only.
+  sheets+45     sheets tilted 45 degrees between the two striped planes: across + z.
                 Both striped cuts show E exactly; the end grain shows diagonal stripes.
-  sheets-45     the other tilt: a = across - z.
+  sheets-45     the other tilt: across - z.
   sheets+45/√2  sheets+45 with E's stripe spacing measured along the sheets' normal:
-                a = (across + z)/√2; every axis cut shows stripes √2 wider.
-  layers        sheets normal to z: a = z. The z cut is one stripe's colour.
+                (across + z)/√2; every axis cut shows stripes √2 wider.
+  layers        sheets normal to z: z. The z cut is one stripe's colour.
 
 Cuts and references are bench_quality's: z (xy plane, x right, y down), y (x right, z down), x
 (y right, z down), each scored against the image its plane gets under the layout, oriented as the
@@ -45,10 +46,13 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_quality import OBLIQUE, SHARED, oblique_over_axis, texmetric  # noqa: E402
 
 DEFAULT_EXEMPLARS = "wood_grain.png:x,wood_planks.png:x,stripes_dunes.png:x,tree_bark.png:y"
-CUT_AXES = {  # pixel (i, j) of a cut is origin + i * u + j * v
+_OBLIQUE = [float(c) for c in OBLIQUE.split(",")]
+ORIGIN = tuple(_OBLIQUE[0:3])  # every cut passes through it
+CUT_AXES = {  # pixel (i, j) of a cut is ORIGIN + i * u + j * v
     "z": ((1, 0, 0), (0, 1, 0)),
     "y": ((1, 0, 0), (0, 0, 1)),
     "x": ((0, 1, 0), (0, 0, 1)),
+    "oblique": (tuple(_OBLIQUE[3:6]), tuple(_OBLIQUE[6:9])),
 }
 SQRT2 = float(np.sqrt(2.0))
 
@@ -80,25 +84,31 @@ def cut_references(exemplar: np.ndarray, grain: str) -> dict:
     return {"z": exemplar, "y": across, "x": across, "oblique": exemplar}
 
 
-def render_cut(exemplar: np.ndarray, solid, u, v, size: int, origin=(0.0, 0.0, 0.0)) -> np.ndarray:
+def render_cut(exemplar: np.ndarray, solid, u, v, size: int) -> np.ndarray:
     h, w, _ = exemplar.shape
     i, j = np.meshgrid(np.arange(size, dtype=np.float64), np.arange(size, dtype=np.float64))
     # Voxels first (a cut samples the nearest voxel), then the voxel's exemplar pixel.
-    x, y, z = (np.rint(origin[k] + i * u[k] + j * v[k]) for k in range(3))
+    x, y, z = (np.rint(ORIGIN[k] + i * u[k] + j * v[k]) for k in range(3))
     col, row = solid(x, y, z)
     return exemplar[np.rint(row).astype(np.int64) % h, np.rint(col).astype(np.int64) % w]
 
 
-def score_solid(python: str, exemplar: np.ndarray, grain: str, solid, size: int, tmp: Path, name: str) -> dict:
-    oblique = [float(c) for c in OBLIQUE.split(",")]
-    axes = dict(CUT_AXES, oblique=(tuple(oblique[3:6]), tuple(oblique[6:9])))
-    references = cut_references(exemplar, grain)
+def write_references(exemplar: np.ndarray, grain: str, tmp: Path, name: str) -> dict:
+    """cut_references as PNGs in `tmp`, once per exemplar: cut -> path."""
+    paths = {}
+    for cut, image in cut_references(exemplar, grain).items():
+        paths[cut] = tmp / f"{name}_{cut}_reference.png"
+        Image.fromarray(image).save(paths[cut])
+    return paths
+
+
+def score_solid(python: str, exemplar: np.ndarray, solid, references: dict, size: int, tmp: Path, name: str) -> dict:
+    """texmetric scores of the solid's four cuts (PNGs `tmp/{name}_{cut}.png`) against `references`."""
     cuts = {}
-    for cut, (u, v) in axes.items():
-        image, reference = tmp / f"{name}_{cut}.png", tmp / f"{name}_{cut}_reference.png"
-        Image.fromarray(render_cut(exemplar, solid, u, v, size, tuple(oblique[0:3]))).save(image)
-        Image.fromarray(references[cut]).save(reference)
-        cuts[cut] = texmetric(python, image, reference)
+    for cut, (u, v) in CUT_AXES.items():
+        image = tmp / f"{name}_{cut}.png"
+        Image.fromarray(render_cut(exemplar, solid, u, v, size)).save(image)
+        cuts[cut] = texmetric(python, image, references[cut])
     return cuts
 
 
@@ -128,8 +138,10 @@ def main() -> int:
             exemplar = np.asarray(Image.open(path).convert("RGB"))
             entry = {"exemplar": path.stem, "grain": grain, "size": args.size, "solids": {}}
             reference = embark.get(f"{path.stem}@{args.size}", {}).get("swd")
+            references = write_references(exemplar, grain, tmp, path.stem)
             for solid_name, solid in solid_maps(grain).items():
-                cuts = score_solid(sys.executable, exemplar, grain, solid, args.size, tmp, f"{path.stem}_{solid_name.replace('/', '_')}")
+                cuts = score_solid(sys.executable, exemplar, solid, references, args.size, tmp,
+                                   f"{path.stem}_{solid_name.replace('/', '_')}")
                 worst = max(c["swd"] for c in cuts.values())
                 entry["solids"][solid_name] = {
                     "cuts": cuts,

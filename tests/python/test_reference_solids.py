@@ -51,12 +51,14 @@ def test_tilted_sheets_show_the_exemplar_on_both_striped_cuts_and_not_on_the_end
     assert np.array_equal(end[1:, :-1], end[:-1, 1:])
     assert not np.array_equal(end[:, 1:], end[:, :-1])
 
+
 def test_texmetric_scores_the_end_grain_of_sheets_far_from_their_striped_cuts(tmp_path):
     if not (refs.SHARED / "tools" / "texmetric.py").is_file():
         pytest.skip(f"{refs.SHARED / 'tools' / 'texmetric.py'} not found: needs ../shared")
     e = striped_exemplar(across_rows=True)
-    sheets = refs.score_solid(sys.executable, e, "x", refs.solid_maps("x")["sheets+45"], 64, tmp_path, "sheets")
-    extruded = refs.score_solid(sys.executable, e, "x", refs.solid_maps("x")["extruded"], 64, tmp_path, "extruded")
+    references = refs.write_references(e, "x", tmp_path, "stripes")
+    sheets = refs.score_solid(sys.executable, e, refs.solid_maps("x")["sheets+45"], references, 64, tmp_path, "sheets")
+    extruded = refs.score_solid(sys.executable, e, refs.solid_maps("x")["extruded"], references, 64, tmp_path, "extruded")
     assert sheets["z"]["swd"] < 0.15 and sheets["y"]["swd"] < 0.15, sheets
     assert sheets["x"]["swd"] > 2 * max(sheets["z"]["swd"], sheets["y"]["swd"]), sheets
     # Extruded along z, the y cut is one stripe colour per row: the stripes are gone.
