@@ -380,9 +380,14 @@ def test_kill_9_of_the_store_or_of_nginx_loses_no_acknowledged_object(cluster, v
     bad = [x for x in records if not isinstance(x[3], int) or x[3] >= 500]
     beyond = [x for x in bad if not excused(x)]
     if "storage" in kills:  # cuts of the loaded volume went on while the store was down
+        # Every new cut asked for during the outage is served, however long synthesis takes on
+        # this machine (how many also end before the store is back depends on its speed: a
+        # 24x24 cut took 0.5-2.7 s on a slow day, and the outage lasts about 4 s).
         t_kill, t_back = kills["storage"]
-        served = [x for x in records if x[2] == "new" and x[3] == 200 and x[0] > t_kill + 0.5 and x[1] < t_back]
-        assert len(served) >= 5, f"only {len(served)} new cuts served during the store's outage"
+        asked = [x for x in records if x[2] == "new" and t_kill + 0.5 < x[0] < t_back]
+        served = [x for x in asked if x[3] == 200]
+        assert len(served) >= 3 and len(served) == len(asked), \
+            (f"{len(served)} of {len(asked)} new cuts asked for during the store's outage served", asked[:10])
     assert not beyond, ("failures beyond the outages", {k: v for k, v in kills.items()}, beyond[:10])
     later = [x for x in records if x[0] > after_all + 0.5]
     assert len(later) >= 10 and all(isinstance(x[3], int) and x[3] < 500 for x in later)
@@ -390,7 +395,7 @@ def test_kill_9_of_the_store_or_of_nginx_loses_no_acknowledged_object(cluster, v
           + ", ".join(f"{k} {b - a:.2f}" for k, (a, b) in kills.items())
           + f"; {sum(1 for x in bad if x[3] == 502)} answered 502, {sum(1 for x in bad if isinstance(x[3], str))} "
           f"refused or cut; acknowledged: {len(load.acked['volumes'])} volumes, {len(load.acked['meshes'])} meshes"
-          + (f"; {len(served)} new cuts served while the store was down" if "storage" in kills else ""))
+          + (f"; {len(served)} new cuts asked for and served while the store was down" if "storage" in kills else ""))
     assert load.acked["volumes"] and load.acked["meshes"]
     for url in [cluster.url] + cluster.replica_urls:
         for vid in load.acked["volumes"]:
