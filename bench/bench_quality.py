@@ -23,8 +23,8 @@ oriented as the cut (`solidtex slice --reference`; it differs from the exemplar 
 cuts along a grain that runs across the image, e.g. an x cut of tree bark's y grain, which then
 also report `as_given`), the oblique cut against the exemplar as given. Embark 2D (../shared/tools/embark-ref, built into BUILD/embark-ref
 with cargo on first use) synthesizes SIZE^2 from the same exemplar. Prints one JSON document
-with per-cut scores, per-exemplar worst-of-four swd over Embark's, and the issue's summary
-measures; writes a montage PNG per exemplar (exemplar repeated at 1:1 | z | y | x | oblique |
+with per-cut scores, per-exemplar worst-of-four swd over Embark's and axis_autocorrelation_gap
+(how far apart any solid's axis cuts must be, below), and the issue's summary measures; writes a montage PNG per exemplar (exemplar repeated at 1:1 | z | y | x | oblique |
 Embark) into DIR.
 """
 from __future__ import annotations
@@ -97,6 +97,32 @@ def oriented_reference(exemplar: Path, exemplar_orientation: tuple[float, float]
     Image.fromarray(np.clip(ref, 0, 255).round().astype(np.uint8)).save(out)
     return {"turn_deg": round(float(np.degrees(turn)), 1), "cut_coherence": round(cut_coherence, 3),
             "exemplar_coherence": round(ex_coherence, 3)}
+
+
+def axis_autocorrelations(image: np.ndarray, max_lag: int = 16) -> tuple[np.ndarray, np.ndarray]:
+    """Normalised autocorrelation of an RGB image (values 0-255 or 0-1) along its rows (lags
+    between columns, the image's u axis) and along its columns (lags between rows, v), for lags
+    1..max_lag, each channel's mean removed, periodic."""
+    a = np.asarray(image, dtype=np.float64)
+    a = a - a.mean(axis=(0, 1))
+    var = float((a * a).sum(axis=2).mean()) + 1e-12
+    lags = range(1, max_lag + 1)
+    along_u = np.array([(a * np.roll(a, -t, axis=1)).sum(axis=2).mean() / var for t in lags])
+    along_v = np.array([(a * np.roll(a, -t, axis=0)).sum(axis=2).mean() / var for t in lags])
+    return along_u, along_v
+
+
+def axis_autocorrelation_gap(image: np.ndarray, max_lag: int = 16) -> float:
+    """max over lags 1..max_lag of |autocorrelation along u - along v| (0-2): how far the
+    exemplar is from looking alike along its two axes. Why it bounds every solid: the three axis
+    cuts share each world axis between two cuts, and each cut's reference (the exemplar in any
+    of its 8 turns and flips) puts its u profile on one of the cut's axes and its v profile on
+    the other; three u's over three axes of two slots each leave some axis with a u profile from
+    one cut and a v profile from the other. A stationary solid has one autocorrelation along
+    that axis, so one of those two cuts misses its reference's by at least half this gap at
+    some lag (README, Quality, "No solid shows a striped exemplar on all three axis cuts")."""
+    along_u, along_v = axis_autocorrelations(image, max_lag)
+    return round(float(np.abs(along_u - along_v).max()), 3)
 
 
 def oblique_over_axis(cuts_by_seed: list[dict], score=lambda c: c["swd"]) -> float:
@@ -184,6 +210,7 @@ def main() -> int:
             cuts = {"z": ["--axis", "z", "--at", "0"], "y": ["--axis", "y", "--at", "0"],
                     "x": ["--axis", "x", "--at", "0"], "oblique": ["--plane", OBLIQUE, "--resample", args.resample]}
             entry = {"exemplar": name, "grain": "x" if name in GRAIN_X else "", "analyze_args": [] if name in GRAIN_X else grain, "size": n, "seeds": {}}
+            entry["axis_autocorrelation_gap"] = axis_autocorrelation_gap(np.asarray(Image.open(ex).convert("RGB")))
             images = [ex]
             ex_orientation = dominant_orientation(ex) if args.oriented else None
             for seed in seeds:

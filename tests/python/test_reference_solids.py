@@ -11,6 +11,7 @@ from PIL import Image
 
 BENCH = Path(__file__).resolve().parents[2] / "bench"
 sys.path.insert(0, str(BENCH))
+import bench_quality as bq  # noqa: E402
 import bench_reference_solids as refs  # noqa: E402
 
 
@@ -64,3 +65,34 @@ def test_texmetric_scores_the_end_grain_of_sheets_far_from_their_striped_cuts(tm
     # Extruded along z, the y cut is one stripe colour per row: the stripes are gone.
     assert extruded["y"]["swd"] > 2 * extruded["z"]["swd"], extruded
     assert Image.open(tmp_path / "sheets_oblique.png").size == (64, 64)
+
+
+def test_one_world_axis_carries_two_cuts_and_the_gap_says_what_that_costs():
+    """The argument behind axis_autocorrelation_gap, on the bench's own cut conventions: under
+    either layout, one world axis is the reference's u axis in one cut and its v axis in the
+    other, so every (stationary) solid misses one of the two by at least half the gap."""
+    e = striped_exemplar(across_rows=True)
+    gap = bq.axis_autocorrelation_gap(e, max_lag=8)
+    assert gap > 1.0
+    assert bq.axis_autocorrelation_gap(e.transpose(1, 0, 2), max_lag=8) == gap
+    noise = np.random.default_rng(3).integers(0, 256, (64, 64, 3))
+    assert bq.axis_autocorrelation_gap(noise, max_lag=8) < 0.1
+    # (cut, its axis that is world `shared`): grain x shares y between the z cut's rows (v) and
+    # the x cut's columns (u); grain y shares x between the z cut's columns and the y cut's.
+    shared = {"x": (("z", "v"), ("x", "u")), "y": (("z", "u"), ("y", "u"))}
+    size = 96  # a multiple of the exemplar's periods, so that integer-map solids tile the cut
+    for grain, pair in shared.items():
+        e = striped_exemplar(across_rows=grain == "x")
+        references = refs.cut_references(e, grain)
+        for name in ("extruded", "sheets+45", "sheets-45", "layers"):
+            solid = refs.solid_maps(grain)[name]
+            profiles, misses = [], []
+            for cut, axis in pair:
+                u, v = refs.CUT_AXES[cut]
+                along_u, along_v = bq.axis_autocorrelations(refs.render_cut(e, solid, u, v, size), 8)
+                ref_u, ref_v = bq.axis_autocorrelations(references[cut], 8)
+                profiles.append(along_u if axis == "u" else along_v)
+                misses.append(np.abs(profiles[-1] - (ref_u if axis == "u" else ref_v)).max())
+            # The same world axis: equal up to the cuts being finite samples of the solid.
+            np.testing.assert_allclose(profiles[0], profiles[1], atol=0.05, err_msg=f"{grain} {name}")
+            assert max(misses) >= gap / 2, (grain, name, misses, gap)
