@@ -24,8 +24,8 @@ cuts along a grain that runs across the image, e.g. an x cut of tree bark's y gr
 also report `as_given`), the oblique cut against the exemplar as given. Embark 2D (../shared/tools/embark-ref, built into BUILD/embark-ref
 with cargo on first use) synthesizes SIZE^2 from the same exemplar. Prints one JSON document
 with per-cut scores, per-exemplar worst-of-four swd over Embark's and axis_autocorrelation_gap
-(see that function), and the issue's summary measures; writes a montage PNG per exemplar (exemplar repeated at 1:1 | z | y | x | oblique |
-Embark) into DIR.
+(see that function), and the issue's summary measures; writes a montage PNG per exemplar
+(exemplar repeated at 1:1 | z | y | x | oblique | Embark) into DIR.
 """
 from __future__ import annotations
 
