@@ -5,7 +5,8 @@ Embark's 2D texture-synthesis on the same exemplar and size.
   bench_quality.py BUILD [--size 256] [--exemplars a.png,b.png] [--out DIR] [--no-embark]
                   [--typicality T]   (synthesis' typicality weight; default: the CLI's default)
                   [--seeds 1,2,3]    (volume seeds; a single cut's swd varies by seed, so an
-                                      exemplar's score is its worst-of-four swd averaged over them)
+                                      exemplar's score is its worst-of-four swd averaged over them,
+                                      and over --shifts)
                   [--resample auto|nearest|cubic] (the oblique cut's sampling; default auto)
                   [--analyze-args "--grain crossed"] (extra analyze flags, for the exemplars
                                       not analysed with --grain x)
@@ -13,6 +14,10 @@ Embark's 2D texture-synthesis on the same exemplar and size.
                                       Embark takes minutes on the large exemplars)
                   [--oriented]       (also score every cut against the exemplar turned to the
                                       cut's own dominant orientation: see oriented_reference)
+                  [--shifts 0,24,48] (translate all four cuts by (d, d, d) finest voxels as well:
+                                      a sample per seed and shift; see cut_set. Grain layouts'
+                                      slabs make a z cut's score depend on its depth, and the
+                                      origin lies on a layer boundary: README, Quality)
 
 For every exemplar in ../shared/data/exemplars (wood_grain and wood_planks analysed with
 --grain x, as the issue asks, the rest with defaults; --grain auto, the default, gives
@@ -125,6 +130,32 @@ def axis_autocorrelation_gap(image: np.ndarray, max_lag: int = 16) -> float:
     return round(float(np.abs(along_u - along_v).max()), 3)
 
 
+def cut_set(shift: int, resample: str) -> dict[str, list[str]]:
+    """The four cuts' `solidtex slice` placement flags, every cut translated by (shift, shift,
+    shift) finest voxels: each cut's first pixel is voxel (shift, shift, shift), so axis cuts
+    lie at depth `shift` with their in-plane origin at (shift, shift) and the oblique passes
+    through that voxel. Shift 0 is the cut set the benchmark has always used."""
+    d = str(shift)
+    u_v = OBLIQUE.split(",")[3:]
+    axis = {a: ["--axis", a, "--at", d, "--origin", f"{d},{d}"] for a in ("z", "y", "x")}
+    return {**axis, "oblique": ["--plane", ",".join([d, d, d, *u_v]), "--resample", resample]}
+
+
+def sample_key(seed: int, shift: int) -> str:
+    """A sample's key in an exemplar's "seeds": the seed alone at shift 0 (as before shifts), else SEED+SHIFT."""
+    return str(seed) if shift == 0 else f"{seed}+{shift}"
+
+
+def worst_by_shift(samples: dict[str, dict], score=lambda c: c["swd"]) -> dict[str, float]:
+    """Per shift, the worst-of-four score averaged over the seeds: how a translation of the cut
+    set moves the exemplar's score (a stationary solid's hardly moves)."""
+    by_shift: dict[str, list[float]] = {}
+    for key, cuts in samples.items():
+        shift = key.split("+")[1] if "+" in key else "0"
+        by_shift.setdefault(shift, []).append(max(score(c) for c in cuts.values()))
+    return {shift: round(float(np.mean(w)), 4) for shift, w in by_shift.items()}
+
+
 def oblique_over_axis(cuts_by_seed: list[dict], score=lambda c: c["swd"]) -> float:
     """Mean oblique swd over mean axis-cut swd, over seeds; `score` picks which swd of a cut."""
     axis = np.mean([score(s[c]) for s in cuts_by_seed for c in ("z", "y", "x")])
@@ -174,11 +205,14 @@ def main() -> int:
     ap.add_argument("--resample", default="auto", choices=["auto", "nearest", "cubic"],
                     help="how the oblique cut samples the voxels (solidtex slice --resample)")
     ap.add_argument("--seeds", default="1", help="comma-separated volume seeds")
+    ap.add_argument("--shifts", default="0",
+                    help="comma-separated translations d of the cut set by (d, d, d) finest voxels (cut_set)")
     ap.add_argument("--embark-cache", type=Path, default=None)
     ap.add_argument("--oriented", action="store_true",
                     help="also score every cut against the exemplar turned to the cut's dominant orientation")
     args = ap.parse_args()
     seeds = [int(s) for s in args.seeds.split(",")]
+    shifts = [int(d) for d in args.shifts.split(",")]
     embark_cache = json.loads(args.embark_cache.read_text()) if args.embark_cache and args.embark_cache.exists() else {}
     build = args.build.resolve()
     solidtex = build / "bin" / "solidtex"
@@ -207,16 +241,16 @@ def main() -> int:
             if not (args.table_cache and table.exists()):
                 table.parent.mkdir(parents=True, exist_ok=True)
                 run([solidtex, "analyze", ex, *grain, "-o", table])
-            cuts = {"z": ["--axis", "z", "--at", "0"], "y": ["--axis", "y", "--at", "0"],
-                    "x": ["--axis", "x", "--at", "0"], "oblique": ["--plane", OBLIQUE, "--resample", args.resample]}
             entry = {"exemplar": name, "grain": "x" if name in GRAIN_X else "", "analyze_args": [] if name in GRAIN_X else grain, "size": n, "seeds": {}}
             entry["axis_autocorrelation_gap"] = axis_autocorrelation_gap(np.asarray(Image.open(ex).convert("RGB")))
             images = [ex]
             ex_orientation = dominant_orientation(ex) if args.oriented else None
-            for seed in seeds:
+            for seed, shift in ((seed, shift) for seed in seeds for shift in shifts):
                 per_seed = {}
-                for cut, where in cuts.items():
-                    image = out_dir / (f"{name}_{cut}.png" if seed == seeds[0] else f"{name}_{cut}_seed{seed}.png")
+                first = seed == seeds[0] and shift == shifts[0]
+                for cut, where in cut_set(shift, args.resample).items():
+                    suffix = ("" if seed == seeds[0] else f"_seed{seed}") + ("" if shift == 0 else f"_shift{shift}")
+                    image = out_dir / (f"{name}_{cut}.png" if first else f"{name}_{cut}{suffix}.png")
                     stats = tmp / f"{name}_{cut}.json"
                     # Axis cuts are judged against the exemplar their plane was synthesized from,
                     # oriented as the cut (solidtex slice --reference): a cut along a y grain shows
@@ -243,10 +277,12 @@ def main() -> int:
                     if "resample" in st:  # plane cuts: what --resample (auto) sampled
                         scores["resample"] = st["resample"]
                     per_seed[cut] = scores
-                    if seed == seeds[0]:
+                    if first:
                         images.append(image)
-                entry["seeds"][str(seed)] = per_seed
-            entry["cuts"] = entry["seeds"][str(seeds[0])]
+                entry["seeds"][sample_key(seed, shift)] = per_seed
+            entry["cuts"] = entry["seeds"][sample_key(seeds[0], shifts[0])]
+            if shifts != [0]:
+                entry["worst_swd_by_shift"] = worst_by_shift(entry["seeds"])
             worsts = [max(c["swd"] for c in s.values()) for s in entry["seeds"].values()]
             entry["worst_swd_mean_over_seeds"] = round(float(np.mean(worsts)), 4)
             # The same with every cut scored against the exemplar as given (before --reference).
@@ -285,7 +321,7 @@ def main() -> int:
         summary.update({"median_worst_swd_over_embark": float(np.median(ratios)),
                         "max_worst_swd_over_embark": float(np.max(ratios)),
                         "median_worst_swd_as_given_over_embark": float(np.median(as_given))})
-    print(json.dumps({"size": n, "typicality": args.typicality, "slice_args": args.slice_args, "resample": args.resample, "analyze_args": args.analyze_args, "seeds": seeds,
+    print(json.dumps({"size": n, "typicality": args.typicality, "slice_args": args.slice_args, "resample": args.resample, "analyze_args": args.analyze_args, "seeds": seeds, "shifts": shifts,
                       "montages": str(out_dir), "exemplars": results, "summary": summary}, indent=1))
     return 0
 

@@ -1,0 +1,47 @@
+"""bench/bench_quality.py's cut set: --shifts translates all four cuts together, and the
+per-shift summary is the worst of four averaged over seeds."""
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+from PIL import Image
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "bench"))
+import bench_quality as bq  # noqa: E402
+from support import run_cli  # noqa: E402
+
+
+def cut_pixels(table: Path, flags: list[str], out: Path, size: int = 12) -> np.ndarray:
+    run_cli("slice", table, *flags, "--size", f"{size},{size}", "--seed", 3, "-o", out)
+    return np.asarray(Image.open(out).convert("RGB")).astype(int)
+
+
+def test_a_shift_translates_the_four_cuts_together(binary, cli_table, tmp_path):
+    """Each cut of cut_set(d) starts at voxel (d, d, d): the z and y cuts share their first row
+    (voxels (d + i, d, d)), the z cut's first column is the x cut's first row ((d, d + i, d)),
+    the x and y cuts share their first column ((d, d, d + j)), and the oblique, sampled
+    nearest, starts with that voxel too. A translation only along the cut axis, or none,
+    breaks all but one of these."""
+    for shift in (0, 5):
+        cuts = {name: cut_pixels(cli_table, [str(f) for f in flags], tmp_path / f"{name}{shift}.png")
+                for name, flags in bq.cut_set(shift, "nearest").items()}
+        z, y, x, oblique = cuts["z"], cuts["y"], cuts["x"], cuts["oblique"]
+        assert np.array_equal(z[0], y[0]), f"shift {shift}: z and y cuts do not share voxels (d+i, d, d)"
+        assert np.array_equal(z[:, 0], x[0]), f"shift {shift}: z and x cuts do not share voxels (d, d+i, d)"
+        assert np.array_equal(x[:, 0], y[:, 0]), f"shift {shift}: x and y cuts do not share voxels (d, d, d+j)"
+        assert np.array_equal(oblique[0, 0], z[0, 0]), f"shift {shift}: the oblique does not pass through (d, d, d)"
+        if shift == 0:
+            unshifted_z = z
+    assert not np.array_equal(unshifted_z, z), "a shift of 5 voxels left the z cut as it was"
+
+
+def test_worst_by_shift_averages_each_shifts_worst_of_four_over_seeds():
+    def cuts(*swd):
+        return {name: {"swd": s} for name, s in zip(("z", "y", "x", "oblique"), swd)}
+
+    samples = {bq.sample_key(1, 0): cuts(0.1, 0.3, 0.2, 0.2), bq.sample_key(2, 0): cuts(0.1, 0.1, 0.5, 0.2),
+               bq.sample_key(1, 24): cuts(0.2, 0.1, 0.1, 0.1), bq.sample_key(2, 24): cuts(0.4, 0.1, 0.1, 0.1)}
+    assert list(samples) == ["1", "2", "1+24", "2+24"]
+    assert bq.worst_by_shift(samples) == {"0": 0.4, "24": 0.3}
