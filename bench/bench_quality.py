@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import itertools
 import shlex
 import subprocess
 import sys
@@ -146,13 +147,17 @@ def sample_key(seed: int, shift: int) -> str:
     return str(seed) if shift == 0 else f"{seed}+{shift}"
 
 
-def worst_by_shift(samples: dict[str, dict], score=lambda c: c["swd"]) -> dict[str, float]:
-    """Per shift, the worst-of-four score averaged over the seeds: how a translation of the cut
-    set moves the exemplar's score (a stationary solid's hardly moves)."""
+def worst_of_four(cuts: dict[str, dict], score=lambda c: c["swd"]) -> float:
+    """A sample's score: its worst cut."""
+    return max(score(c) for c in cuts.values())
+
+
+def worst_by_shift(worst: dict[tuple[int, int], float]) -> dict[str, float]:
+    """Per shift, the worst-of-four scores (keyed by (seed, shift)) averaged over the seeds: how
+    a translation of the cut set moves the exemplar's score (a stationary solid's hardly moves)."""
     by_shift: dict[str, list[float]] = {}
-    for key, cuts in samples.items():
-        shift = key.split("+")[1] if "+" in key else "0"
-        by_shift.setdefault(shift, []).append(max(score(c) for c in cuts.values()))
+    for (_, shift), w in worst.items():
+        by_shift.setdefault(str(shift), []).append(w)
     return {shift: round(float(np.mean(w)), 4) for shift, w in by_shift.items()}
 
 
@@ -245,7 +250,7 @@ def main() -> int:
             entry["axis_autocorrelation_gap"] = axis_autocorrelation_gap(np.asarray(Image.open(ex).convert("RGB")))
             images = [ex]
             ex_orientation = dominant_orientation(ex) if args.oriented else None
-            for seed, shift in ((seed, shift) for seed in seeds for shift in shifts):
+            for seed, shift in itertools.product(seeds, shifts):
                 per_seed = {}
                 first = seed == seeds[0] and shift == shifts[0]
                 for cut, where in cut_set(shift, args.resample).items():
@@ -281,12 +286,13 @@ def main() -> int:
                         images.append(image)
                 entry["seeds"][sample_key(seed, shift)] = per_seed
             entry["cuts"] = entry["seeds"][sample_key(seeds[0], shifts[0])]
+            worst = {(seed, shift): worst_of_four(entry["seeds"][sample_key(seed, shift)])
+                     for seed, shift in itertools.product(seeds, shifts)}
             if shifts != [0]:
-                entry["worst_swd_by_shift"] = worst_by_shift(entry["seeds"])
-            worsts = [max(c["swd"] for c in s.values()) for s in entry["seeds"].values()]
-            entry["worst_swd_mean_over_seeds"] = round(float(np.mean(worsts)), 4)
+                entry["worst_swd_by_shift"] = worst_by_shift(worst)
+            entry["worst_swd_mean_over_seeds"] = round(float(np.mean(list(worst.values()))), 4)
             # The same with every cut scored against the exemplar as given (before --reference).
-            worsts_as_given = [max(c.get("as_given", c)["swd"] for c in s.values()) for s in entry["seeds"].values()]
+            worsts_as_given = [worst_of_four(s, lambda c: c.get("as_given", c)["swd"]) for s in entry["seeds"].values()]
             entry["worst_swd_as_given_mean_over_seeds"] = round(float(np.mean(worsts_as_given)), 4)
             if embark:
                 image = out_dir / f"{name}_embark.png"

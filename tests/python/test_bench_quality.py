@@ -41,7 +41,9 @@ def test_worst_by_shift_averages_each_shifts_worst_of_four_over_seeds():
     def cuts(*swd):
         return {name: {"swd": s} for name, s in zip(("z", "y", "x", "oblique"), swd)}
 
-    samples = {bq.sample_key(1, 0): cuts(0.1, 0.3, 0.2, 0.2), bq.sample_key(2, 0): cuts(0.1, 0.1, 0.5, 0.2),
-               bq.sample_key(1, 24): cuts(0.2, 0.1, 0.1, 0.1), bq.sample_key(2, 24): cuts(0.4, 0.1, 0.1, 0.1)}
-    assert list(samples) == ["1", "2", "1+24", "2+24"]
-    assert bq.worst_by_shift(samples) == {"0": 0.4, "24": 0.3}
+    samples = {(1, 0): cuts(0.1, 0.3, 0.2, 0.2), (2, 0): cuts(0.1, 0.1, 0.5, 0.2),
+               (1, 24): cuts(0.2, 0.1, 0.1, 0.1), (2, 24): cuts(0.4, 0.1, 0.1, 0.1)}
+    assert [bq.sample_key(*k) for k in samples] == ["1", "2", "1+24", "2+24"]
+    worst = {k: bq.worst_of_four(c) for k, c in samples.items()}
+    assert worst == {(1, 0): 0.3, (2, 0): 0.5, (1, 24): 0.2, (2, 24): 0.4}
+    assert bq.worst_by_shift(worst) == {"0": 0.4, "24": 0.3}
