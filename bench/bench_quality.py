@@ -17,7 +17,7 @@ Embark's 2D texture-synthesis on the same exemplar and size.
                   [--shifts 0,24,48] (translate all four cuts by (d, d, d) finest voxels as well:
                                       a sample per seed and shift; see cut_set. Grain layouts'
                                       slabs make a z cut's score depend on its depth, and the
-                                      origin lies on a layer boundary: README, Quality)
+                                      origin lies on a layer boundary: docs/quality.md)
 
 For every exemplar in ../shared/data/exemplars (wood_grain and wood_planks analysed with
 --grain x, as the issue asks, the rest with defaults; --grain auto, the default, gives
@@ -85,7 +85,7 @@ def oriented_reference(exemplar: Path, exemplar_orientation: tuple[float, float]
     """The exemplar (its dominant_orientation given: one per exemplar, not per cut) turned so
     its dominant orientation is the cut's, SIZE^2, sampled cubically
     and periodically (texmetric treats the exemplar as periodic too). Why: a grained solid is
-    made of sheets whose tilt synthesis chooses (README, Quality, "How the grained solids are
+    made of sheets whose tilt synthesis chooses (docs/quality.md, "How the grained solids are
     built"), so an oblique cut shows the grain turned by an angle no layout fixes beforehand,
     and the exemplar as given scores the turn, not the texture. The cubic resampling smooths
     the reference a little (a 0.3 degree turn of tree_bark lowers its z cut's swd 0.111 ->
@@ -126,7 +126,7 @@ def axis_autocorrelation_gap(image: np.ndarray, max_lag: int = 16) -> float:
     the other; three u's over three axes of two slots each leave some axis with a u profile from
     one cut and a v profile from the other. A stationary solid has one autocorrelation along
     that axis, so one of those two cuts misses its reference's by at least half this gap at
-    some lag (README, Quality, "No solid shows a striped exemplar on all three axis cuts")."""
+    some lag (docs/quality.md, "No solid shows a striped exemplar on all three axis cuts")."""
     along_u, along_v = axis_autocorrelations(image, max_lag)
     return round(float(np.abs(along_u - along_v).max()), 3)
 

@@ -5,7 +5,7 @@ built from a striped exemplar score on bench_quality's four cuts, scored the sam
   bench_reference_solids.py [--size 256] [--exemplars a.png:x,b.png:y] [--embark-cache F]
 
 A grain layout (`solidtex analyze --grain x|y`) asks two planes for the stripes and the third
-for the end grain, an image of E, too. No solid meets all three (README, Quality, "How the
+for the end grain, an image of E, too. No solid meets all three (docs/quality.md, "How the
 grained solids are built"); this measures how close simple coherent solids come. Each
 reference solid copies one exemplar pixel per voxel through a linear map of world (x, y, z) to
 exemplar (column, row), so it is a voxel solid synthesis could in principle produce, with the

@@ -16,7 +16,7 @@ inline constexpr int kAutoLevels = 0;
 // N x N templates: the most levels whose coarsest template (N * 2^(L-1) pixels wide) spans at
 // most half that side, clamped to [1, 8]. 64^2 gets 2, 96^2 and 128^2 3, 256^2 4, 512^2 5 for
 // N = 9. A coarsest template wider than that matches the whole exemplar against itself and
-// loses its structure; measured on the shared exemplars at 256^2 (README, Quality: "Levels").
+// loses its structure; measured on the shared exemplars at 256^2 (docs/quality.md: "Levels").
 int auto_levels(int shorter_side, int neighborhood);
 
 struct AnalysisParams {

@@ -30,7 +30,7 @@ struct ExemplarInputs {
 };
 
 // The suggested plane weight of a grain layout's end-grain plane, which the exemplar cannot
-// show. 0.3 since grain layouts vote (README, Quality, "Grain layouts vote"): with votes, every
+// show. 0.3 since grain layouts vote (docs/quality.md, "Grain layouts vote"): with votes, every
 // grain exemplar's worst cut and z cut scored better than with medoids at 0.1 (other long-grain
 // cuts moved both ways: wood_planks y 0.200 -> 0.210); tables analysed before keep their 0.1.
 inline constexpr float kEndGrainWeight = 0.3f;
@@ -48,7 +48,7 @@ inline constexpr float kEndGrainWeight = 0.3f;
 // k+1's first axis, so with one image every crossbar matches the exemplar's vertical profiles
 // against its horizontal ones; crossed makes two of the three crossbars compare like with
 // like (no layout fixes all three), which keeps the structure of exemplars whose directions
-// differ (lit stones, brick courses, weaves: README, Quality). Three distinct images lose the
+// differ (lit stones, brick courses, weaves: docs/quality.md). Three distinct images lose the
 // cyclic symmetry that lets analysis search one plane; yz and zx, holding E transposed, share
 // E's searches (candidate_triples.h), so about 1.4x the analysis time.
 // Returns the layout applied: "", "x", "y" or "crossed". Fails for an explicit layout with yz/zx.

@@ -77,7 +77,7 @@ void matching_color(const TableLevel& level, const CoordinateTriple& t, int chan
 // `w` are normalised weights (not all zero).
 void output_color(const Table& table, const CoordinateTriple& t, const PlaneWeights& w, ColorRule rule, float rgb[3]);
 // The rule `rule` stands for: kAuto is kVote on every table (one image, crossed, grain layouts:
-// README, Quality, "Grain layouts vote"). Other rules are themselves. Stored volumes pin
+// docs/quality.md, "Grain layouts vote"). Other rules are themselves. Stored volumes pin
 // "auto", so this rule is part of their look (it changed once, for three-plane tables, from
 // medoid to vote): a new rule needs a new name.
 ColorRule resolved_color_rule(ColorRule rule);

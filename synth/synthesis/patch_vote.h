@@ -3,7 +3,7 @@
 //
 // Why: per-voxel k-coherence (correction.h) leaves each plane's coordinates continuing a
 // neighbour's patch only about a fifth of the time, so colouring every voxel from its own
-// triple (mean or medoid) makes every cut a mosaic of 1-2 voxel pieces (README, Quality, "Why
+// triple (mean or medoid) makes every cut a mosaic of 1-2 voxel pieces (docs/quality.md, "Why
 // cuts are mosaics"). The vote asks the neighbours which exemplar pixel their patches continue
 // into the voxel, and copies the one most of them agree on, so cuts show exemplar patches.
 //
@@ -33,7 +33,7 @@
 namespace solidtex {
 
 // A vote's colour distance penalty: 2 makes a pixel 0.7 (of 1 per channel) away from the
-// medoid cost as much as one full-weight vote. Measured (README, Quality).
+// medoid cost as much as one full-weight vote. Measured (docs/quality.md).
 inline constexpr float kVoteColorPull = 2.f;
 
 // Plane k's neighbour pixels T_k(u) of the 9 steps, in stencil order ((b + 1) * 3 + (a + 1)).

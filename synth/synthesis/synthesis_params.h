@@ -33,7 +33,7 @@ enum class Scheme {
 // How the coarsest level's version 0 is made (pyramid_init.h).
 enum class Init {
   kAuto,     // scatter for one shared exemplar and for the crossed layout (isotropic), slab for
-             // three planes (grain layouts, three images), each measured best there (README, Quality)
+             // three planes (grain layouts, three images), each measured best there (docs/quality.md)
   kSlab,     // Zhang §4.1: candidate slabs (exemplar xy thickened along z) tiled per subpart;
              // in isotropic solids it leaves streaks along z in x and y cuts that one fine pass
              // does not remove; with a grain along x its slabs are planks along the grain
@@ -47,11 +47,11 @@ enum class ColorRule {
   kMean,    // the plane-weighted mean (Zhang et al.): where the three pixels disagree it is a
             // color none of them has, which blurs edges and flattens contrast
   kMedoid,  // the pixel whose plane-weighted squared color distance to the other two is least:
-            // always an exemplar color (README, Quality: worst swd 3-10 % lower on 4 of 5 exemplars)
+            // always an exemplar color (docs/quality.md: worst swd 3-10 % lower on 4 of 5 exemplars)
   kVote,    // the exemplar pixel the voxel's neighbours' patches continue into it most often
             // (synthesis/patch_vote.h): reads the final triples one step around the voxel
   kAuto,    // kVote on every table: one image, crossed, grain layouts (whose end-grain weight
-            // rose to 0.3 with it), as measured (README, Quality, "Patch votes", "Grain layouts
+            // rose to 0.3 with it), as measured (docs/quality.md, "Patch votes", "Grain layouts
             // vote"); resolved_color_rule()
 };
 Result<ColorRule> parse_color_rule(const std::string& name);
@@ -62,7 +62,7 @@ const char* scheme_name(Scheme s);
 
 // The typicality auto resolves to (resolved_typicality in correction.h): one image and the
 // crossed layout (isotropic solids) take kTypicality; three planes (grain layouts, three
-// images) take kThreePlaneTypicality, measured best there (README, Quality, "Grain layouts
+// images) take kThreePlaneTypicality, measured best there (docs/quality.md, "Grain layouts
 // match less typically").
 inline constexpr float kTypicality = 0.5f;
 inline constexpr float kThreePlaneTypicality = 0.35f;
@@ -80,11 +80,11 @@ struct SynthesisParams {
   // 5.3 -> 3.9 s, worst swd at 96^2 within seed noise of s = 2 and sharper.
   int finest_subpass_size = 1;
   int cell_size = 12;        // M: grid cell side in voxels of the level, [4, 64]
-  // Auto by default, chosen by measurement (README, Quality): isotropic solids' x and y cuts
+  // Auto by default, chosen by measurement (docs/quality.md): isotropic solids' x and y cuts
   // lose the slabs' streaks along z; grained solids keep their slabs. Volumes pin it, and
   // volumes stored before restore with kSlab. It depends on the table only, so it is stable.
   Init init = Init::kAuto;
-  // Output colors: auto by default (README, Quality: "Patch votes"); volumes stored before it
+  // Output colors: auto by default (docs/quality.md: "Patch votes"); volumes stored before it
   // was pinned restore with kMean, volumes pinned to medoid keep it. Matching colors (the
   // coarser levels' neighbourhoods) stay plane-weighted means, so every rule has the same triples.
   ColorRule color = ColorRule::kAuto;

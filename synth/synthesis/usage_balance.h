@@ -21,7 +21,7 @@
 // of the levels at spacing <= 2 (the two finest) are multiplied by `fine_gain`: structured
 // exemplars keep re-using a few regions at the finer levels after calibration, and twice the
 // penalty there sharpens bricks, weave and pebbles (256^2 worst-of-four swd -12 %, -12 %, -7 %)
-// for marble +5 %, gravel and leopard within 1 % (README, Quality). Grain layouts keep gain 1:
+// for marble +5 %, gravel and leopard within 1 % (docs/quality.md). Grain layouts keep gain 1:
 // wood_planks' cuts got 3-8 % worse, stripes' and bark's no better.
 //
 // Cost: `rounds` finest-block syntheses, whatever the exemplar's size (about 1-2 s each on 2 cores).

@@ -5,7 +5,7 @@
 // 40-48 %, bicubically 1-4 %). Catmull-Rom resampling (target.h) removes them but attenuates
 // 1-voxel detail, and a solid's cuts carry that detail where the exemplar does. Which costs
 // more is a property of the exemplar: the share of its fine contrast that is 1-pixel detail
-// (fine_detail_share). Measured on the ten shared exemplars (README, Quality, "Oblique cuts"),
+// (fine_detail_share). Measured on the ten shared exemplars (docs/quality.md, "Oblique cuts"),
 // cubic made every oblique 256^2 cut with a share <= 0.40 better and every one with a share
 // >= 0.46 worse, so `auto` picks cubic below kCubicMaxFineDetailShare, between the two.
 //
@@ -47,7 +47,7 @@ double fine_detail_share(const Table& table);
 inline constexpr double kCubicMaxFineDetailShare = 0.43;
 // With patch-vote colours (ColorRule::kVote) cuts are exemplar patches, not single-voxel
 // mosaics, and cubic resampling pays up to more detail: better on bricks (0.51) and marble
-// (0.46), still worse on weave (0.59), tree_bark (0.58) and wood_grain (0.68) (README, Quality).
+// (0.46), still worse on weave (0.59), tree_bark (0.58) and wood_grain (0.68) (docs/quality.md).
 inline constexpr double kCubicMaxFineDetailShareVote = 0.55;
 // kCubic when fine_detail_share(table) is below the threshold of the table's resolved colour
 // rule (`color`, resolved_color_rule), else kNearest.

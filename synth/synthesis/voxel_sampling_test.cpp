@@ -139,7 +139,7 @@ TEST(VoxelSampling, PointsOnAPlaneResampleExactlyLikeThePlaneCut) {
   EXPECT_EQ(TargetSet::points(scattered, std::nullopt, VoxelSampling::kCubic).value().sampling(), VoxelSampling::kNearest);
 }
 
-// The measurement the threshold rests on (README, Quality, "Oblique cuts"): cubic resampling
+// The measurement the threshold rests on (docs/quality.md, "Oblique cuts"): cubic resampling
 // made the oblique 256^2 cut better on these five shared exemplars and worse on the other five.
 // Their shares, by texmetric's pyramid over their 8-bit sRGB pixels: 0.27-0.40 and 0.46-0.68.
 TEST(VoxelSampling, SharedExemplarsSplitAsMeasured) {
@@ -156,7 +156,7 @@ TEST(VoxelSampling, SharedExemplarsSplitAsMeasured) {
     EXPECT_GT(std::abs(share - kCubicMaxFineDetailShare), 0.02) << name << " sits on the threshold: " << share;
   }
   // With patch-vote colours (the isotropic exemplars' default) cubic was better on bricks and
-  // marble_pink too, and still worse on these three (README, Quality, "Patch votes").
+  // marble_pink too, and still worse on these three (docs/quality.md, "Patch votes").
   const std::map<std::string, bool> cubic_was_better_voting = {
       {"bricks", true}, {"marble_pink", true}, {"tree_bark", false}, {"weave_burlap", false}, {"wood_grain", false}};
   for (const auto& [name, better] : cubic_was_better_voting) {
