@@ -47,3 +47,10 @@ def test_worst_by_shift_averages_each_shifts_worst_of_four_over_seeds():
     worst = {k: bq.worst_of_four(c) for k, c in samples.items()}
     assert worst == {(1, 0): 0.3, (2, 0): 0.5, (1, 24): 0.2, (2, 24): 0.4}
     assert bq.worst_by_shift(worst) == {"0": 0.4, "24": 0.3}
+
+
+def test_embark_runs_keep_seed_one_where_the_cache_had_it_and_average_into_the_denominator():
+    assert bq.embark_key("bricks", 256, 1) == "bricks@256", "seed 1's key must stay the one older caches hold"
+    keys = {bq.embark_key("bricks", 256, s) for s in (1, 2, 3)} | {bq.embark_key("bricks", 128, 2)}
+    assert len(keys) == 4, "seeds and sizes must not share a cache entry"
+    assert bq.embark_swd({1: {"swd": 0.13}, 2: {"swd": 0.12}, 3: {"swd": 0.11}}) == 0.12
