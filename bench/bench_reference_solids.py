@@ -43,7 +43,7 @@ import numpy as np
 from PIL import Image
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_quality import OBLIQUE, SHARED, axis_autocorrelation_gap, oblique_over_axis, texmetric  # noqa: E402
+from bench_quality import OBLIQUE, SHARED, axis_autocorrelation_gap, embark_key, oblique_over_axis, texmetric  # noqa: E402
 
 DEFAULT_EXEMPLARS = "wood_grain.png:x,wood_planks.png:x,stripes_dunes.png:x,tree_bark.png:y"
 _OBLIQUE = [float(c) for c in OBLIQUE.split(",")]
@@ -138,7 +138,7 @@ def main() -> int:
             exemplar = np.asarray(Image.open(path).convert("RGB"))
             entry = {"exemplar": path.stem, "grain": grain, "size": args.size,
                      "axis_autocorrelation_gap": axis_autocorrelation_gap(exemplar), "solids": {}}
-            reference = embark.get(f"{path.stem}@{args.size}", {}).get("swd")
+            reference = embark.get(embark_key(path.stem, args.size, 1), {}).get("swd")
             references = write_references(exemplar, grain, tmp, path.stem)
             for solid_name, solid in solid_maps(grain).items():
                 cuts = score_solid(sys.executable, exemplar, solid, references, args.size, tmp,
