@@ -302,13 +302,13 @@ def main() -> int:
                         images.append(image)
                 entry["seeds"][sample_key(seed, shift)] = per_seed
             entry["cuts"] = entry["seeds"][sample_key(seeds[0], shifts[0])]
-            worst = {(seed, shift): worst_of_four(entry["seeds"][sample_key(seed, shift)])
-                     for seed, shift in itertools.product(seeds, shifts)}
+            samples = {(seed, shift): entry["seeds"][sample_key(seed, shift)] for seed, shift in itertools.product(seeds, shifts)}
+            worst = {key: worst_of_four(cuts) for key, cuts in samples.items()}
             if shifts != [0]:
                 entry["worst_swd_by_shift"] = worst_by_shift(worst)
             entry["worst_swd_mean_over_seeds"] = round(float(np.mean(list(worst.values()))), 4)
             # The same with every cut scored against the exemplar as given (before --reference).
-            worsts_as_given = [worst_of_four(s, lambda c: c.get("as_given", c)["swd"]) for s in entry["seeds"].values()]
+            worsts_as_given = [worst_of_four(cuts, lambda c: c.get("as_given", c)["swd"]) for cuts in samples.values()]
             entry["worst_swd_as_given_mean_over_seeds"] = round(float(np.mean(worsts_as_given)), 4)
             if embark:
                 runs = {}
