@@ -176,6 +176,7 @@ int main(int argc, char** argv) {
     }
     out[corrected ? "corrected" : "upsampled_only"] = {
         {"passes", p.passes}, {"typicality", resolved_typicality(**table, p.typicality)}, {"finest_subpass_size", p.finest_subpass_size},
+        {"finest_typicality_scale", p.finest_typicality_scale},
         {"levels", measure(**table, (*synth)->cache(), o.size, normalised_weights(p.plane_weights))}};
   }
   std::cout << out.dump() << "\n";

@@ -103,7 +103,7 @@ ImageF axis_cut_exemplar(const Table& table, char axis) {
 Status run_slice(const std::vector<std::string>& argv) {
   Args args({"-o", "--axis", "--at", "--origin", "--plane", "--resample", "--size", "--scheme", "--field", "--seed", "--threads",
              "--stats", "--passes", "--coarse-passes", "--cell", "--cache-mb", "--plane-weights", "--matcher", "--region-table", "--regions",
-             "--typicality", "--balance", "--init", "--color", "--finest-subpass-size", "--reference"},
+             "--typicality", "--finest-typicality-scale", "--balance", "--init", "--color", "--finest-subpass-size", "--reference"},
             {"--energy"});
   SOLIDTEX_RETURN_IF_ERROR(args.parse(argv));
   if (args.positionals().size() != 1)
@@ -141,6 +141,9 @@ Status run_slice(const std::vector<std::string>& argv) {
     SOLIDTEX_ASSIGN_OR_RETURN(double typicality, args.get_double("--typicality", kTypicality, 0, 4));
     params.typicality = float(typicality);
   }
+  SOLIDTEX_ASSIGN_OR_RETURN(double finest_scale,
+                            args.get_double("--finest-typicality-scale", params.finest_typicality_scale, 0, 1));
+  params.finest_typicality_scale = float(finest_scale);
   SOLIDTEX_ASSIGN_OR_RETURN(double balance, args.get_double("--balance", params.balance, 0, 4));
   params.balance = float(balance);
   SOLIDTEX_RETURN_IF_ERROR(params.validate());

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <array>
+#include <charconv>
 #include <cmath>
+#include <cstdlib>
 #include <cstdint>
 #include <optional>
 #include <set>
@@ -57,6 +59,7 @@ constexpr Param<SynthesisParams> kSynthesisParams[] = {
     {"trilinear_levels", &SynthesisParams::trilinear_levels, 0, 8},
     {"plane_weights", &SynthesisParams::plane_weights, 0, 1},
     {"typicality", &SynthesisParams::typicality, 0, 4},
+    {"finest_typicality_scale", &SynthesisParams::finest_typicality_scale, 0, 1},
     {"balance", &SynthesisParams::balance, 0, 4},
 };
 
@@ -126,6 +129,15 @@ Status read_param(const Param<P>& d, const json& v, const std::string& field, P&
       d.member);
 }
 
+// A float as the shortest decimal that reads back to it (0.7f as 0.7, not 0.699999988079071):
+// what a client wrote comes back as written, and reading it back gives the same float.
+json shortest(float f) {
+  char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof buf, f);
+  *r.ptr = '\0';
+  return json(std::strtod(buf, nullptr));
+}
+
 template <typename P, size_t N>
 json write_params(const P& p, const Param<P> (&table)[N]) {
   json out = json::object();
@@ -135,7 +147,11 @@ json write_params(const P& p, const Param<P> (&table)[N]) {
                                 [&](Matcher P::*m) { return json(matcher_name(p.*m)); },
                                 [&](Init P::*m) { return json(init_name(p.*m)); },
                                 [&](ColorRule P::*m) { return json(color_rule_name(p.*m)); },
-                                [&](std::optional<float> P::*m) { return p.*m ? json(*(p.*m)) : json("auto"); },
+                                [&](std::optional<float> P::*m) { return p.*m ? shortest(*(p.*m)) : json("auto"); },
+                                [&](float P::*m) { return shortest(p.*m); },
+                                [&](std::array<float, 3> P::*m) {
+                                  return json::array({shortest((p.*m)[0]), shortest((p.*m)[1]), shortest((p.*m)[2])});
+                                },
                                 [&](auto m) { return json(p.*m); },
                             },
                             d.member);

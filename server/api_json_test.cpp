@@ -32,7 +32,7 @@ TEST(ApiJson, WireFormatOfTheDefaults) {
             R"({"candidates":12,"knn_checks":192,"levels":0,"neighborhood":9,"pca_dims":20,"search_k":24,"seed":1,)"
             R"("suggested_plane_weights":[1.0,1.0,1.0]})");
   EXPECT_EQ(to_json(SynthesisParams{}).dump(),
-            R"({"balance":1.0,"cell_size":12,"coarse_passes":3,"color":"auto","finest_subpass_size":1,"init":"auto","init_subpart":32,"matcher":"paper","passes":1,)"
+            R"({"balance":1.0,"cell_size":12,"coarse_passes":3,"color":"auto","finest_subpass_size":1,"finest_typicality_scale":0.7,"init":"auto","init_subpart":32,"matcher":"paper","passes":1,)"
             R"("plane_weights":[1.0,1.0,1.0],"scheme":"dual-grid","subpass_size":2,"trilinear_levels":2,"typicality":"auto"})");
 }
 
@@ -68,6 +68,18 @@ TEST(ApiJson, EveryKeyReadsBackWhatItWrites) {
   EXPECT_EQ(s2->scheme, Scheme::kGrid);
   EXPECT_EQ(s2->plane_weights, s.plane_weights);
   EXPECT_EQ(s2->typicality, 1.25f);
+  // floats are written as the shortest decimal that reads back to them: what a client wrote
+  s.typicality = 0.35f;
+  s.finest_typicality_scale = 0.3f;
+  s.plane_weights = {0.1f, 1.f, 0.7f};
+  EXPECT_EQ(to_json(s)["typicality"].dump(), "0.35");
+  EXPECT_EQ(to_json(s)["finest_typicality_scale"].dump(), "0.3");
+  EXPECT_EQ(to_json(s)["plane_weights"].dump(), "[0.1,1.0,0.7]");
+  auto s4 = synthesis_params_from_json(to_json(s), "params", SynthesisParams{});
+  ASSERT_TRUE(s4.is_ok()) << s4.status().to_string();
+  EXPECT_EQ(s4->typicality, 0.35f);
+  EXPECT_EQ(s4->finest_typicality_scale, 0.3f);
+  EXPECT_EQ(s4->plane_weights, s.plane_weights);
   // "auto" reads as absent over any base, and writes back as "auto"
   SynthesisParams base;
   base.typicality = 0.5f;
@@ -119,6 +131,8 @@ TEST(ApiJson, ErrorsNameTheField) {
       {{{"typicality", "high"}}, "params.typicality", "must be a number or \"auto\""},
       {{{"typicality", "0.5"}}, "params.typicality", "must be a number or \"auto\""},
       {{{"typicality", nullptr}}, "params.typicality", "must be a number or \"auto\""},
+      {{{"finest_typicality_scale", 1.5}}, "params.finest_typicality_scale", "must be in [0.000000, 1.000000]"},
+      {{{"finest_typicality_scale", "auto"}}, "params.finest_typicality_scale", "must be a number"},
   };
   for (const Case& c : synthesis) {
     const Status st = synthesis_error(c.j);

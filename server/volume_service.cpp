@@ -571,19 +571,19 @@ bool pin_params(json& spec, const json& values) {
 
 // The defaults a new volume pins (SynthesisParams), and the ones volumes stored before each
 // was pinned were synthesized with: typicality did not exist (0), fine levels ran two
-// correction passes, the coarsest level started from slabs, output colors were means, and the
-// finest level ran 8 subpasses per pass, and usage penalties were not applied.
+// correction passes, the coarsest level started from slabs, output colors were means, the
+// finest level ran 8 subpasses per pass, usage penalties were not applied, and the finest
+// level matched with the same typicality as the others.
 json current_defaults() {
-  const SynthesisParams d;
-  return {{"typicality", d.typicality ? json(*d.typicality) : json("auto")},
-          {"balance", d.balance},
-          {"passes", d.passes},
-          {"init", init_name(d.init)},
-          {"color", color_rule_name(d.color)},
-          {"finest_subpass_size", d.finest_subpass_size}};
+  const json all = to_json(SynthesisParams{});
+  json pinned = json::object();
+  for (const char* key : {"typicality", "balance", "passes", "init", "color", "finest_subpass_size", "finest_typicality_scale"})
+    pinned[key] = all.at(key);
+  return pinned;
 }
 json legacy_defaults() {
-  return {{"typicality", 0.0}, {"passes", 2}, {"init", "slab"}, {"color", "mean"}, {"finest_subpass_size", 2}, {"balance", 0.0}};
+  return {{"typicality", 0.0}, {"passes", 2},  {"init", "slab"}, {"color", "mean"}, {"finest_subpass_size", 2},
+          {"balance", 0.0},    {"finest_typicality_scale", 1.0}};
 }
 
 }  // namespace

@@ -176,13 +176,18 @@ float resolved_typicality(const Table& table, std::optional<float> typicality) {
   return e.shared() || e.crossed() ? kTypicality : kThreePlaneTypicality;
 }
 
+float level_typicality(const Table& table, PyramidLevel l, const SynthesisParams& params) {
+  const float t = resolved_typicality(table, params.typicality);
+  return table.spacing(l) == 1 ? t * params.finest_typicality_scale : t;
+}
+
 CorrectionContext CorrectionContext::make(const Table& table, PyramidLevel l, const SynthesisParams& params) {
   CorrectionContext ctx;
   ctx.candidates_per_source = params.matcher == Matcher::kCoherent ? 4 : 64;
   ctx.cost_weights = params.plane_weights;
   ctx.color_weights = normalised_weights(params.plane_weights);
   ctx.color_rule = resolved_color_rule(params.color);
-  ctx.typicality = resolved_typicality(table, params.typicality);
+  ctx.typicality = level_typicality(table, l, params);
   ctx.level = &table.level(l);
   for (int k = 0; k < 3; ++k) {
     const PlaneAppearance& app = *ctx.level->planes[size_t(k)];

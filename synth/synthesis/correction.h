@@ -87,6 +87,10 @@ ColorRule resolved_color_rule(ColorRule rule);
 // (synthesis_params.h). A function of the table only, so voxels stay spatially deterministic.
 // Stored volumes pin "auto", so this rule is part of their look: a new rule needs a new name.
 float resolved_typicality(const Table& table, std::optional<float> typicality);
+// The typicality weight matching uses at level `l`: resolved_typicality(), times
+// params.finest_typicality_scale at the finest level (spacing 1). A scale of 1 gives exactly
+// the resolved weight, bit for bit (volumes stored before the scale restore with 1).
+float level_typicality(const Table& table, PyramidLevel l, const SynthesisParams& params);
 
 // Per-level constants of the correction, precomputed once per synthesizer.
 struct CorrectionContext {
@@ -100,7 +104,7 @@ struct CorrectionContext {
   int candidates_per_source = 64;                    // table candidates tried per source pixel
   PlaneWeights color_weights{1.f / 3, 1.f / 3, 1.f / 3};
   ColorRule color_rule = ColorRule::kMedoid;         // output colors only, resolved (never kAuto)
-  float typicality = 0.f;                            // resolved_typicality()
+  float typicality = 0.f;                            // level_typicality()
   // Per plane, every exemplar pixel's penalty added to its match cost: typicality times its
   // typicality penalty plus balance times its usage penalty (float ops in that order); null
   // when both weights are 0 or there is nothing to weigh. Shared by planes sharing an image.

@@ -83,6 +83,8 @@ Status SynthesisParams::validate() const {
   if (!(total > 0.f)) return Status(StatusCode::kInvalidArgument, "must not all be zero", "plane_weights");
   if (typicality && !(*typicality >= 0.f && *typicality <= 4.f))
     return Status(StatusCode::kInvalidArgument, "must be in [0, 4]", "typicality");
+  if (!(finest_typicality_scale >= 0.f && finest_typicality_scale <= 1.f))
+    return Status(StatusCode::kInvalidArgument, "must be in [0, 1]", "finest_typicality_scale");
   if (!(balance >= 0.f && balance <= 4.f)) return Status(StatusCode::kInvalidArgument, "must be in [0, 4]", "balance");
   return Status::ok();
 }

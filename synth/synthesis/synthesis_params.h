@@ -66,6 +66,10 @@ const char* scheme_name(Scheme s);
 // match less typically").
 inline constexpr float kTypicality = 0.5f;
 inline constexpr float kThreePlaneTypicality = 0.35f;
+// The finest level's share of the typicality weight (SynthesisParams::finest_typicality_scale):
+// 0.7 measured best there on one image (0.5 -> 0.35) and within noise on three planes
+// (docs/quality.md, "The finest level matches less typically").
+inline constexpr float kFinestTypicalityScale = 0.7f;
 
 struct SynthesisParams {
   Scheme scheme = Scheme::kDualGrid;
@@ -102,6 +106,12 @@ struct SynthesisParams {
   // auto, the default: resolved_typicality() (correction.h) picks per table. Volumes pin it;
   // volumes stored before auto keep the 0.5 they pinned.
   std::optional<float> typicality;
+  // The finest level's (spacing 1) typicality weight as a multiple of the resolved `typicality`,
+  // [0, 1]. The finest level adds pixel-scale detail, where a strong pull away from the mean
+  // appearance turns edges into speckle (gravel's dark specks, marble's vein clusters): 0.7,
+  // the default, measured best (docs/quality.md, "The finest level matches less typically").
+  // Volumes pin it; volumes stored before it restore with 1 (the same weight at every level).
+  float finest_typicality_scale = kFinestTypicalityScale;
   // Weight of the table's usage penalties in matching costs (synthesis/usage_balance.h), [0, 4]:
   // 1 applies them as calibrated (exemplar regions the matching over-uses cost more, regions
   // it neglects less: Kopf et al.'s histogram matching as a fixed function of the table);

@@ -570,6 +570,43 @@ TEST(SynthesizerTypicality, AutoTakesTheThreePlaneWeightOnGrainTablesOnly) {
   }
 }
 
+// finest_typicality_scale weighs the finest level's typicality only: the coarser levels' voxels
+// are the same bits at any scale, the finest level's are not, and a scale of 1 is the resolved
+// weight at every level (what volumes stored before the scale restore with).
+TEST(SynthesizerTypicality, FinestScaleWeighsTheFinestLevelOnly) {
+  const auto table = small_table(ProceduralKind::kSpots, false);
+  const int L = table->levels();
+  const float resolved = resolved_typicality(*table, std::nullopt);
+  for (const float scale : {0.f, kFinestTypicalityScale, 1.f}) {
+    SynthesisParams p = small_params();
+    p.finest_typicality_scale = scale;
+    for (int l = 0; l < L; ++l)
+      EXPECT_EQ(level_typicality(*table, PyramidLevel{l}, p), l == L - 1 ? resolved * scale : resolved) << l;
+  }
+  EXPECT_EQ(SynthesisParams{}.finest_typicality_scale, kFinestTypicalityScale);
+  EXPECT_LT(kFinestTypicalityScale, 1.f);
+
+  auto at_scale = [&](float scale, int level) {
+    SynthesisParams p = small_params();
+    p.finest_typicality_scale = scale;
+    SynthesisOptions o;
+    o.level = level;
+    o.max_bytes = int64_t(1) << 30;
+    auto r = make(table, "identity", p)->synthesize(TargetSet::box({0, 0, 0}, 12, 12, 1).value(), null_interrupter(),
+                                                    nullptr, o);
+    EXPECT_TRUE(r.is_ok()) << r.status().to_string();
+    return r.is_ok() ? *r : std::vector<std::array<float, 3>>{};
+  };
+  EXPECT_EQ(at_scale(kFinestTypicalityScale, L - 2), at_scale(1.f, L - 2)) << "a coarser level changed";
+  EXPECT_NE(at_scale(kFinestTypicalityScale, L - 1), at_scale(1.f, L - 1)) << "the finest level did not change";
+
+  SynthesisParams bad = small_params();
+  for (const float v : {-0.1f, 1.5f}) {
+    bad.finest_typicality_scale = v;
+    EXPECT_EQ(bad.validate().field(), "finest_typicality_scale") << v;
+  }
+}
+
 TEST(SynthesizerQuality, VoteColorsCopyExemplarPatchesWhereMedoidsMakeAMosaic) {
   EXPECT_EQ(SynthesisParams{}.color, ColorRule::kAuto);
   EXPECT_EQ(resolved_color_rule(ColorRule::kAuto), ColorRule::kVote);

@@ -170,6 +170,15 @@ def test_finest_subpass_size_takes_1_and_2_only(srv):
     assert cuts[1] != cuts[2]
 
 
+def test_finest_typicality_scale_takes_0_to_1_only(srv):
+    # both ends of [0, 1] and the default synthesize; 0.7 (the default, pinned when absent) is
+    # written back as given; 0 and 1 differ (on this grained exemplar auto typicality is 0.35)
+    cuts = takes_its_values_only(srv, "finest_typicality_scale", (0, 0.7, 1), 0.7,
+                                 (-0.001, 1.001, 1e308, "0.7", "auto", None, [0.7]))
+    assert cuts[0] != cuts[1]
+    assert cuts[0.7] == slice_of(srv, create_volume(srv).json()["id"], size="8,8").content
+
+
 def test_color_takes_its_four_names_only(srv):
     # auto (the default: vote, also on this grained exemplar), vote, medoid and mean
     # synthesize the same triples and differ in colors only

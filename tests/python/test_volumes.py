@@ -58,7 +58,7 @@ def test_slice_variants_agree_and_match_cli(shared, tmp_path):
 
 
 def test_cli_color_and_finest_subpass_flags_match_the_service(shared, tmp_path):
-    # the CLI's --color and --finest-subpass-size at both of their values give the service's
+    # the CLI's --color and --finest-subpass-size at each of their values give the service's
     # bits for a volume with the same params; other values are errors naming the flag
     import subprocess
     c = shared.client
@@ -68,9 +68,18 @@ def test_cli_color_and_finest_subpass_flags_match_the_service(shared, tmp_path):
         run_cli("slice", shared.table_path, "--axis", "z", "--at", "3", "--size", "16,12", "--seed", "7",
                 "--color", color, "--finest-subpass-size", s, "-o", out)
         assert np.array_equal(file_pixels(out), c.slice(vid, "z", 3, (16, 12))), (color, s)
+    # --finest-typicality-scale likewise (the default, 0.7, is the first volume's above)
+    for scale in (0, 1):
+        vid = c.create_volume(exemplar=shared.exemplar_id, seed=7, params={"finest_typicality_scale": scale})["id"]
+        out = tmp_path / f"scale{scale}.png"
+        run_cli("slice", shared.table_path, "--axis", "z", "--at", "3", "--size", "16,12", "--seed", "7",
+                "--finest-typicality-scale", scale, "-o", out)
+        assert np.array_equal(file_pixels(out), c.slice(vid, "z", 3, (16, 12))), scale
     for flag, bad, named in (("--color", "median", "color: unknown color 'median'"),
                              ("--finest-subpass-size", "3", "--finest-subpass-size: is 3"),
-                             ("--finest-subpass-size", "0", "--finest-subpass-size: is 0")):
+                             ("--finest-subpass-size", "0", "--finest-subpass-size: is 0"),
+                             ("--finest-typicality-scale", "1.5", "--finest-typicality-scale: is 1.5; out of range"),
+                             ("--finest-typicality-scale", "auto", "--finest-typicality-scale: 'auto' is not a number")):
         proc = subprocess.run([str(solidtex_bin()), "slice", str(shared.table_path), "--axis", "z", "--at", "0",
                                "--size", "4,4", flag, bad, "-o", str(tmp_path / "x.png")], capture_output=True, text=True)
         assert proc.returncode != 0 and named in proc.stderr, proc.stderr
@@ -313,9 +322,9 @@ def test_old_scheme_name_is_rejected_and_plain_works(shared, tmp_path):
     run_cli("slice", shared.table_path, "--axis", "z", "--at", "3", "--size", "32,24",
             "--seed", "7", "--scheme", "plain", "-o", out)
     assert np.array_equal(file_pixels(out), png_pixels(png)), "service plain != CLI --scheme plain"
-    # the default scheme, dual-grid; the typicality, passes, init, color, subpass and balance defaults are pinned into the stored params
+    # the default scheme, dual-grid; the typicality, passes, init, color, subpass, balance and finest scale defaults are pinned
     assert shared.volume["params"] == {"typicality": "auto", "passes": 1, "init": "auto", "color": "auto", "finest_subpass_size": 1,
-                                       "balance": 1.0}, shared.volume
+                                       "balance": 1.0, "finest_typicality_scale": 0.7}, shared.volume
     default = c.slice(shared.volume_id, "z", 3, (32, 24))
     assert not np.array_equal(png_pixels(png), default), "plain and dual-grid gave the same slice"
     c.delete_volume(vol["id"])
