@@ -582,8 +582,8 @@ json current_defaults() {
   return pinned;
 }
 json legacy_defaults() {
-  return {{"typicality", 0.0}, {"passes", 2},  {"init", "slab"}, {"color", "mean"}, {"finest_subpass_size", 2},
-          {"balance", 0.0},    {"finest_typicality_scale", 1.0}};
+  return {{"typicality", 0.0}, {"passes", 2}, {"init", "slab"}, {"color", "mean"},
+          {"finest_subpass_size", 2}, {"balance", 0.0}, {"finest_typicality_scale", 1.0}};
 }
 
 }  // namespace
