@@ -103,7 +103,7 @@ ImageF axis_cut_exemplar(const Table& table, char axis) {
 Status run_slice(const std::vector<std::string>& argv) {
   Args args({"-o", "--axis", "--at", "--origin", "--plane", "--resample", "--size", "--scheme", "--field", "--seed", "--threads",
              "--stats", "--passes", "--coarse-passes", "--cell", "--cache-mb", "--plane-weights", "--matcher", "--region-table", "--regions",
-             "--typicality", "--finest-typicality-scale", "--balance", "--init", "--color", "--finest-subpass-size", "--reference"},
+             "--typicality", "--finest-typicality-scale", "--balance", "--init", "--init-band", "--color", "--finest-subpass-size", "--reference"},
             {"--energy"});
   SOLIDTEX_RETURN_IF_ERROR(args.parse(argv));
   if (args.positionals().size() != 1)
@@ -131,6 +131,7 @@ Status run_slice(const std::vector<std::string>& argv) {
   SOLIDTEX_ASSIGN_OR_RETURN(params.coarse_passes, args.get_int("--coarse-passes", params.coarse_passes, 0, 8));
   SOLIDTEX_ASSIGN_OR_RETURN(params.cell_size, args.get_int("--cell", params.cell_size, 4, 64));
   SOLIDTEX_ASSIGN_OR_RETURN(params.finest_subpass_size, args.get_int("--finest-subpass-size", params.finest_subpass_size, 1, 2));
+  SOLIDTEX_ASSIGN_OR_RETURN(params.init_band, args.get_int("--init-band", params.init_band, 0, 256));  // validate(): 0 or even >= 8
   SOLIDTEX_ASSIGN_OR_RETURN(auto table, load_table(args.positionals()[0]));
   params.plane_weights = table->params().suggested_plane_weights;
   if (args.has("--plane-weights")) {

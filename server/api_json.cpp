@@ -56,6 +56,7 @@ constexpr Param<SynthesisParams> kSynthesisParams[] = {
     {"init", &SynthesisParams::init},
     {"color", &SynthesisParams::color},
     {"init_subpart", &SynthesisParams::init_subpart, 8, 256},
+    {"init_band", &SynthesisParams::init_band, 0, 256},
     {"trilinear_levels", &SynthesisParams::trilinear_levels, 0, 8},
     {"plane_weights", &SynthesisParams::plane_weights, 0, 1},
     {"typicality", &SynthesisParams::typicality, 0, 4},

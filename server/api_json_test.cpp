@@ -32,7 +32,7 @@ TEST(ApiJson, WireFormatOfTheDefaults) {
             R"({"candidates":12,"knn_checks":192,"levels":0,"neighborhood":9,"pca_dims":20,"search_k":24,"seed":1,)"
             R"("suggested_plane_weights":[1.0,1.0,1.0]})");
   EXPECT_EQ(to_json(SynthesisParams{}).dump(),
-            R"({"balance":1.0,"cell_size":12,"coarse_passes":3,"color":"auto","finest_subpass_size":1,"finest_typicality_scale":0.7,"init":"auto","init_subpart":32,"matcher":"paper","passes":1,)"
+            R"({"balance":1.0,"cell_size":12,"coarse_passes":3,"color":"auto","finest_subpass_size":1,"finest_typicality_scale":0.7,"init":"auto","init_band":8,"init_subpart":32,"matcher":"paper","passes":1,)"
             R"("plane_weights":[1.0,1.0,1.0],"scheme":"dual-grid","subpass_size":2,"trilinear_levels":2,"typicality":"auto"})");
 }
 
@@ -59,6 +59,7 @@ TEST(ApiJson, EveryKeyReadsBackWhatItWrites) {
   s.cell_size = 16;
   s.init = Init::kSlab;
   s.init_subpart = 64;
+  s.init_band = 0;
   s.trilinear_levels = 0;
   s.plane_weights = {0.5f, 1.f, 0.f};
   s.typicality = 1.25f;
@@ -125,6 +126,10 @@ TEST(ApiJson, ErrorsNameTheField) {
       {{{"plane_weights", {1, 2, 1}}}, "params.plane_weights", "must be in [0.000000, 1.000000]"},
       {{{"plane_weights", {0, 0, 0}}}, "params.plane_weights", "must not all be zero"},  // validate()
       {{{"init_subpart", 9}}, "params.init_subpart", "must be even"},                    // validate()
+      {{{"init_band", 4}}, "params.init_band", "must be 0 or in [8, 256]"},              // validate()
+      {{{"init_band", 9}}, "params.init_band", "must be even"},                          // validate()
+      {{{"init_band", 10.5}}, "params.init_band", "must be an integer"},
+      {{{"init_band", 300}}, "params.init_band", "must be in [0, 256]"},
       {{{"init", "random"}}, "params.init", "unknown init 'random'"},
       {{{"color", "median"}}, "params.color", "unknown color 'median'"},
       {{{"typicality", 5}}, "params.typicality", "must be in [0.000000, 4.000000]"},

@@ -29,6 +29,16 @@ CoordinateTriple scatter_triple(const Table& table, const Voxel& v, uint32_t see
 }
 }  // namespace
 
+std::array<int, 3> slab_subpart_sides(const Table& table, const SynthesisParams& params) {
+  const int k = params.init_subpart, b = params.init_band;
+  std::array<int, 3> sides{k, k, k};
+  if (b == 0) return sides;
+  const auto& w = table.params().suggested_plane_weights;  // (xy, yz, zx)
+  if (w[1] >= w[2]) sides[0] = b;
+  if (w[2] >= w[1]) sides[1] = b;
+  return sides;
+}
+
 Init resolved_init(const Table& table, Init init) {
   if (init != Init::kAuto) return init;
   const ExemplarSet& e = table.exemplars();
@@ -40,9 +50,9 @@ CoordinateTriple init_triple(const Table& table, const Voxel& v, const Rot3& r, 
   const PyramidLevel coarsest{0};
   const int h = table.spacing(coarsest);
   const int n = table.params().neighborhood;
-  const int k = params.init_subpart;
-  const int sx = floor_div(v.x, k), sy = floor_div(v.y, k), sz = floor_div(v.z, k);
-  const int cx = sx * k + k / 2, cy = sy * k + k / 2, cz = sz * k + k / 2;
+  const std::array<int, 3> k = slab_subpart_sides(table, params);
+  const int sx = floor_div(v.x, k[0]), sy = floor_div(v.y, k[1]), sz = floor_div(v.z, k[2]);
+  const int cx = sx * k[0] + k[0] / 2, cy = sy * k[1] + k[1] / 2, cz = sz * k[2] + k[2] / 2;
   const float rel[3] = {float(v.x - cx), float(v.y - cy), float(v.z - cz)};
   float local[3];
   r.apply_inverse(rel, local);

@@ -74,6 +74,9 @@ Status SynthesisParams::validate() const {
   SOLIDTEX_RETURN_IF_ERROR(range(cell_size, 4, 64, "cell_size"));
   SOLIDTEX_RETURN_IF_ERROR(range(init_subpart, 8, 256, "init_subpart"));
   if (init_subpart % 2) return Status(StatusCode::kInvalidArgument, "must be even", "init_subpart");
+  if (init_band != 0 && (init_band < 8 || init_band > 256))
+    return Status(StatusCode::kInvalidArgument, "is " + std::to_string(init_band) + "; must be 0 or in [8, 256]", "init_band");
+  if (init_band % 2) return Status(StatusCode::kInvalidArgument, "must be even", "init_band");
   SOLIDTEX_RETURN_IF_ERROR(range(trilinear_levels, 0, 8, "trilinear_levels"));
   float total = 0.f;
   for (float w : plane_weights) {

@@ -93,6 +93,17 @@ struct SynthesisParams {
   // coarser levels' neighbourhoods) stay plane-weighted means, so every rule has the same triples.
   ColorRule color = ColorRule::kAuto;
   int init_subpart = 32;     // K: coarsest-level voxels per slab-initialisation subpart side, even, [8, 256]
+  // B: the subparts' side (coarsest-level voxels) along the slabs' across-grain axis instead of
+  // K, even, 0 or [8, 256]; 0 keeps K (cubic subparts). The slabs extrude the xy exemplar along
+  // z; the long-grain plane they cross (zx for grain x, yz for grain y; both when the table's
+  // yz and zx weigh alike) sees that extrusion as streaks, which the correction keeps wherever
+  // no subpart seam lies within a neighbourhood's reach across that plane's normal (y for
+  // grain x, x for grain y). Bands of 8 put a seam in every coarsest neighbourhood's reach
+  // there, and their seams run along the grain, so the slab plane's cuts keep their
+  // grain: measured (docs/quality.md, "Slab bands across the grain") against cubic subparts of
+  // 32, 8 (the default) removes the streak blocks, the default's choice. Volumes pin it;
+  // volumes stored before restore with 0 (bit for bit the cubic subparts). Scatter ignores it.
+  int init_band = 8;
   int trilinear_levels = 2;  // the coarsest this-many levels sample neighborhoods trilinearly, [0, 8]
   uint32_t seed = 1;         // hashed with (voxel, level) wherever synthesis needs randomness
   // Relative weight of each plane (xy, yz, zx) in matching costs and voxel colors, [0, 1],
