@@ -27,6 +27,9 @@ std::shared_ptr<const Table> grain_table(const ImageF& xy, const ImageF& zx) {
   ap.neighborhood = 7;
   ap.candidates = 8;
   ap.pca_dims = 12;
+  // as apply_grain_layout("x") suggests: slab bands (SynthesisParams::init_band) read the layout
+  // from these, so the end grain is the yz plane, as grain_params() weighs it
+  ap.suggested_plane_weights = {1.f, kEndGrainWeight, 1.f};
   return analyze(ExemplarSet::create(std::move(in)).value(), ap).value().table;
 }
 

@@ -179,6 +179,13 @@ def test_finest_typicality_scale_takes_0_to_1_only(srv):
     assert cuts[0.7] == slice_of(srv, create_volume(srv).json()["id"], size="8,8").content
 
 
+def test_init_band_takes_0_or_an_even_side_from_8_to_256_only(srv):
+    # 0 (cubic subparts, what volumes stored before bands restore with), the default 8 (pinned
+    # when absent) and the far end 256 synthesize on this grained (slab) exemplar; odd, too
+    # small, too large and non-integer bands are 400s naming params.init_band
+    takes_its_values_only(srv, "init_band", (0, 8, 256), 8, (-2, 2, 6, 9, 258, 1e9, 8.5, "8", None, [8]))
+
+
 def test_color_takes_its_four_names_only(srv):
     # auto (the default: vote, also on this grained exemplar), vote, medoid and mean
     # synthesize the same triples and differ in colors only
