@@ -8,7 +8,7 @@
 // cut into subparts of K voxels a side (B along the slabs' across-grain axes:
 // slab_subpart_sides); a voxel v in the subpart with centre c reads the tiled volume at
 // w = lround(R^T (v - c)) + c, so the slab pattern turns with the local frame about c and
-// rotation-induced distortion stays bounded by K (Fig. 4).
+// rotation-induced distortion stays bounded by the subpart's size (Fig. 4).
 // Scatter initialisation (SynthesisParams::init; auto's choice for one shared exemplar): voxel w takes the first
 // candidate triple of the exemplar pixel hash(w, seed); neither the field nor K matter, since
 // a pattern of independent draws looks the same turned. The coarse passes then grow
