@@ -618,29 +618,36 @@ TEST(SynthesizerQuality, VoteColorsCopyExemplarPatchesWhereMedoidsMakeAMosaic) {
   expect_votes_copy_patches(ProceduralKind::kWood, true, 2.5);
 }
 
-// Luminance autocorrelation of an image at `lag` pixels along its rows' direction (x) minus
-// along its columns (y): > 0 when the image is streaked along x.
-double streak_along_x(const ImageF& img, int lag) {
+// Luminance autocorrelation of an image at `lag` pixels along its rows (x) and along its
+// columns (y), each over the pairs it has.
+struct Autocorrelation {
+  double along_x = 0, along_y = 0;
+};
+Autocorrelation luminance_autocorrelation(const ImageF& img, int lag) {
   std::vector<double> l(size_t(img.width) * size_t(img.height));
-  double mean = 0;
-  for (int y = 0; y < img.height; ++y)
-    for (int x = 0; x < img.width; ++x) {
-      const float* p = img.at(x, y);
-      l[size_t(y) * img.width + x] = 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
-      mean += l[size_t(y) * img.width + x];
-    }
-  mean /= double(l.size());
-  double var = 0, along_x = 0, along_y = 0;
-  for (double& v : l) {
-    v -= mean;
-    var += v * v;
+  double mean = 0, var = 0;
+  for (size_t i = 0; i < l.size(); ++i) {
+    const float* p = &img.pixels[i * size_t(img.channels)];
+    l[i] = 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+    mean += l[i];
   }
+  mean /= double(l.size());
+  for (double& v : l) var += (v -= mean) * v;
+  var /= double(l.size());
+  Autocorrelation r;
   for (int y = 0; y < img.height; ++y)
-    for (int x = 0; x + lag < img.width; ++x) along_x += l[size_t(y) * img.width + x] * l[size_t(y) * img.width + x + lag];
+    for (int x = 0; x + lag < img.width; ++x) r.along_x += l[size_t(y) * img.width + x] * l[size_t(y) * img.width + x + lag];
   for (int y = 0; y + lag < img.height; ++y)
-    for (int x = 0; x < img.width; ++x) along_y += l[size_t(y) * img.width + x] * l[size_t(y + lag) * img.width + x];
-  const double pairs = double(img.height) * (img.width - lag);
-  return (along_x - along_y) / pairs / (var / double(l.size()));
+    for (int x = 0; x < img.width; ++x) r.along_y += l[size_t(y) * img.width + x] * l[size_t(y + lag) * img.width + x];
+  r.along_x /= double(img.height) * (img.width - lag) * var;
+  r.along_y /= double(img.height - lag) * img.width * var;
+  return r;
+}
+
+// > 0 when the image is streaked along x.
+double streak_along_x(const ImageF& img, int lag) {
+  const Autocorrelation r = luminance_autocorrelation(img, lag);
+  return r.along_x - r.along_y;
 }
 
 // 3D consistency: in x and y cuts of an isotropic exemplar, z is an axis like the others.
@@ -673,22 +680,6 @@ TEST(SynthesizerQuality, XAndYCutsAreNotStreakedAlongZ) {
   EXPECT_GT(slab, scatter + 0.05) << "the measure no longer sees the slabs' streaks";
 }
 
-// Luminance autocorrelation of an image at `lag` pixels along its columns (y).
-double autocorrelation_along_y(const ImageF& img, int lag) {
-  std::vector<double> l(size_t(img.width) * size_t(img.height));
-  double mean = 0, var = 0, along = 0;
-  for (size_t i = 0; i < l.size(); ++i) {
-    const float* p = &img.pixels[i * size_t(img.channels)];
-    l[i] = 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
-    mean += l[i];
-  }
-  mean /= double(l.size());
-  for (double& v : l) var += (v -= mean) * v;
-  for (int y = 0; y + lag < img.height; ++y)
-    for (int x = 0; x < img.width; ++x) along += l[size_t(y) * img.width + x] * l[size_t(y + lag) * img.width + x];
-  return along / (double(img.height - lag) * img.width) / (var / double(l.size()));
-}
-
 // Grain layouts keep slabs, and a slab's extrusion along z survives as streak blocks in the
 // long-grain cut it crosses (the y cut for grain x) wherever no subpart seam lies within a
 // neighbourhood's reach across y (docs/quality.md, "Slab bands across the grain"). On the real
@@ -714,7 +705,7 @@ TEST(SynthesizerQuality, SlabBandsAcrossTheGrainUnstreakTheLongGrainCut) {
     for (int at : {24, 48}) {
       // A y cut puts z on the image's y: pixel (i, j) is voxel (i, at, j).
       const ImageF img = rgb_image(cut(*s, 'y', at, 0, 0, 128, 128), 128, 128);
-      sum += autocorrelation_along_y(img, 4);
+      sum += luminance_autocorrelation(img, 4).along_y;
       ++n;
     }
     return sum / n;
