@@ -1,6 +1,7 @@
 // Benchmark (diagnostic, issue #12): how coherent a cut's coordinate triples are, level by
 // level, and how far the three exemplar pixels of a finest triple agree. Prints one JSON object.
 //   bench_coherence TABLE.stx [--size N] [--typicality auto|T] [--passes P] [--finest-subpass-size S]
+//                   [--finest-match auto|triple|plane]
 // A z cut N x N (default 128) at z = 0, identity field, default parameters otherwise (the
 // table's suggested plane weights), synthesized twice: as configured, and with no correction
 // at the finer levels (upsampling only: the coarsest level's result carried down). Per level:
@@ -33,6 +34,7 @@ struct Options {
   std::optional<float> typicality = SynthesisParams{}.typicality;  // absent: auto, per table
   int passes = SynthesisParams{}.passes;
   int finest_subpass_size = SynthesisParams{}.finest_subpass_size;
+  FinestMatch finest_match = SynthesisParams{}.finest_match;
 };
 
 // "auto" is absent (resolved per table), anything else a weight.
@@ -137,9 +139,17 @@ int main(int argc, char** argv) {
     else if (a == "--typicality" && has_value) o.typicality = typicality_arg(argv[++i]);
     else if (a == "--passes" && has_value) o.passes = std::atoi(argv[++i]);
     else if (a == "--finest-subpass-size" && has_value) o.finest_subpass_size = std::atoi(argv[++i]);
-    else if (o.table.empty() && a.rfind("--", 0) != 0) o.table = a;
+    else if (a == "--finest-match" && has_value) {
+      auto m = parse_finest_match(argv[++i]);
+      if (!m) {
+        std::cerr << m.status().to_string() << "\n";
+        return 2;
+      }
+      o.finest_match = *m;
+    } else if (o.table.empty() && a.rfind("--", 0) != 0) o.table = a;
     else {
-      std::cerr << "usage: bench_coherence TABLE.stx [--size N] [--typicality auto|T] [--passes P] [--finest-subpass-size S]\n";
+      std::cerr << "usage: bench_coherence TABLE.stx [--size N] [--typicality auto|T] [--passes P] [--finest-subpass-size S] "
+                   "[--finest-match auto|triple|plane]\n";
       return 2;
     }
   }
@@ -159,6 +169,7 @@ int main(int argc, char** argv) {
     p.typicality = o.typicality;
     p.passes = corrected ? o.passes : 0;
     p.finest_subpass_size = o.finest_subpass_size;
+    p.finest_match = o.finest_match;
     if (Status s = p.validate(); !s.is_ok()) {
       std::cerr << s.to_string() << "\n";
       return 2;

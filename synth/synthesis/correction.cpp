@@ -170,6 +170,15 @@ ColorRule resolved_color_rule(ColorRule rule) {
   return rule == ColorRule::kAuto ? ColorRule::kVote : rule;
 }
 
+FinestMatch resolved_finest_match(const Table& table, FinestMatch m) {
+  if (m != FinestMatch::kAuto) return m;
+  // Planes where two or more levels lie above the finest, which then only adds pixel-scale
+  // detail; triples on two-level tables (small exemplars: leopard), whose finest level still
+  // shapes the structure and needs the three planes to agree there (docs/quality.md, "The
+  // finest level matches plane by plane").
+  return table.levels() >= 3 ? FinestMatch::kPlane : FinestMatch::kTriple;
+}
+
 float resolved_typicality(const Table& table, std::optional<float> typicality) {
   if (typicality) return *typicality;
   const ExemplarSet& e = table.exemplars();
@@ -207,6 +216,7 @@ CorrectionContext CorrectionContext::make(const Table& table, PyramidLevel l, co
   }
   ctx.n = table.params().neighborhood;
   ctx.spacing = table.spacing(l);
+  ctx.plane_wise = ctx.spacing == 1 && resolved_finest_match(table, params.finest_match) == FinestMatch::kPlane;
   ctx.channels = table.exemplars().channels();
   ctx.dims = ctx.level->planes[0]->pca.output_dims;
   for (int k = 0; k < 3; ++k) ctx.projection[size_t(k)] = PcaProjection::of(ctx.level->planes[size_t(k)]->pca);
@@ -296,6 +306,24 @@ CoordinateTriple best_candidate(const CorrectionContext& ctx, const CoordinateTr
     const PlaneAppearance& app = *level.planes[size_t(k)];
     cur.at[size_t(k)] = {ImageF::wrap(cur.at[size_t(k)].x, app.stack.width), ImageF::wrap(cur.at[size_t(k)].y, app.stack.height)};
     cur_terms[size_t(k)] = term[size_t(k)](pixel_index(app, cur.at[size_t(k)]));
+  }
+  if (ctx.plane_wise) {
+    // Each plane's pixel by its own term: the minimum of (term, y, x) over the plane's current
+    // pixel and sources, independent of the order they are visited in.
+    for (int k = 0; k < 3; ++k) {
+      const PlaneAppearance& app = *level.planes[size_t(k)];
+      float best_k = cur_terms[size_t(k)];
+      ExemplarPixel& pick = cur.at[size_t(k)];
+      for (const ExemplarPixel& raw : sources[size_t(k)]) {
+        const ExemplarPixel src{ImageF::wrap(raw.x, app.stack.width), ImageF::wrap(raw.y, app.stack.height)};
+        const float t = term[size_t(k)](pixel_index(app, src));
+        if (t < best_k || (t == best_k && (src.y < pick.y || (src.y == pick.y && src.x < pick.x)))) {
+          best_k = t;
+          pick = src;
+        }
+      }
+    }
+    return cur;
   }
   offer((cur_terms[0] + cur_terms[1]) + cur_terms[2], cur);
 

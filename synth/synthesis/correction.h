@@ -11,6 +11,11 @@
 // the level. Trilinear levels blend the 8 surrounding voxels (corners of weight exactly 0 are
 // not read); the others take the nearest voxel (std::lround on each axis).
 //
+// Plane-wise matching (CorrectionContext::plane_wise; FinestMatch::kPlane at the finest level):
+// the cost is a sum of per-plane terms, so each plane's coordinate is chosen on its own, from
+// its current pixel and its nine sources T_k(u) - h*(a, b), the lowest term winning (equal terms
+// to the smaller (y, x)). Every plane then continues a neighbour's patch in that plane.
+//
 // Candidate set S(v): the voxel's current triple, plus for every plane k and in-plane step
 // (a, b) in {-1,0,1}^2 the N_T table candidates of plane k at T_k(u) - h*(a, b), where
 // u = p + lround(R * local(a, b)) (the reduced d-set of §4.3). Matching: each plane's gathered
@@ -81,6 +86,12 @@ void output_color(const Table& table, const CoordinateTriple& t, const PlaneWeig
 // "auto", so this rule is part of their look (it changed once, for three-plane tables, from
 // medoid to vote): a new rule needs a new name.
 ColorRule resolved_color_rule(ColorRule rule);
+// What `m` stands for on `table`: kAuto is kPlane on tables of three or more levels and
+// kTriple on two-level tables (measured: docs/quality.md, "The finest level matches plane by
+// plane"); the others are themselves. A function of the table only,
+// so voxels stay spatially deterministic; stored volumes pin "auto", so the rule is part of
+// their look: a new rule needs a new name.
+FinestMatch resolved_finest_match(const Table& table, FinestMatch m);
 // The typicality weight `typicality` stands for on `table`: itself when given; auto (absent)
 // is kThreePlaneTypicality on tables with three planes that are not the crossed layout (grain
 // layouts, three images: the slab-initialised solids of resolved_init), else kTypicality
@@ -102,6 +113,9 @@ struct CorrectionContext {
   std::array<PcaProjection, 3> projection;           // per plane
   PlaneWeights cost_weights{1.f, 1.f, 1.f};          // per-plane matching weights
   int candidates_per_source = 64;                    // table candidates tried per source pixel
+  // Each plane's coordinate chosen on its own (FinestMatch::kPlane at the finest level): the
+  // table's candidate lists are not read, only each plane's sources and the current triple.
+  bool plane_wise = false;
   PlaneWeights color_weights{1.f / 3, 1.f / 3, 1.f / 3};
   ColorRule color_rule = ColorRule::kMedoid;         // output colors only, resolved (never kAuto)
   float typicality = 0.f;                            // level_typicality()

@@ -41,6 +41,17 @@ const char* color_rule_name(ColorRule c) {
   }
 }
 
+Result<FinestMatch> parse_finest_match(const std::string& name) {
+  if (name == "auto") return FinestMatch::kAuto;
+  if (name == "triple") return FinestMatch::kTriple;
+  if (name == "plane") return FinestMatch::kPlane;
+  return Status(StatusCode::kInvalidArgument, "unknown finest_match '" + name + "' (auto, triple, plane)", "finest_match");
+}
+
+const char* finest_match_name(FinestMatch m) {
+  return m == FinestMatch::kAuto ? "auto" : m == FinestMatch::kTriple ? "triple" : "plane";
+}
+
 Result<Matcher> parse_matcher(const std::string& name) {
   if (name == "paper") return Matcher::kPaper;
   if (name == "coherent") return Matcher::kCoherent;

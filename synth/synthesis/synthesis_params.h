@@ -57,6 +57,20 @@ enum class ColorRule {
 Result<ColorRule> parse_color_rule(const std::string& name);
 const char* color_rule_name(ColorRule c);
 
+// What the finest level's correction chooses from the candidate set S(v) (correction.h).
+enum class FinestMatch {
+  kTriple,  // whole candidate triples (Zhang §4.3): each plane's coordinate comes with the two
+            // others the table stored beside it, so a voxel continues one plane's patch and the
+            // other two planes' coordinates start anew (cuts are mosaics of 1-2 voxel pieces)
+  kPlane,   // each plane's coordinate on its own: the current one or a neighbour's in that plane
+            // continued into the voxel, whichever matches that plane's neighbourhood best (2D
+            // k-coherence in every plane). The three pixels may then disagree; the output color
+            // rule (vote) picks one, and the finest level's matching colors feed nothing finer
+  kAuto,    // resolved_finest_match() (correction.h)
+};
+Result<FinestMatch> parse_finest_match(const std::string& name);
+const char* finest_match_name(FinestMatch m);
+
 Result<Scheme> parse_scheme(const std::string& name);
 const char* scheme_name(Scheme s);
 
@@ -92,6 +106,9 @@ struct SynthesisParams {
   // was pinned restore with kMean, volumes pinned to medoid keep it. Matching colors (the
   // coarser levels' neighbourhoods) stay plane-weighted means, so every rule has the same triples.
   ColorRule color = ColorRule::kAuto;
+  // How the finest level's correction picks (FinestMatch): auto by default; volumes pin it, and
+  // volumes stored before restore with kTriple (bit for bit what they were made with).
+  FinestMatch finest_match = FinestMatch::kAuto;
   int init_subpart = 32;     // K: coarsest-level voxels per slab-initialisation subpart side, even, [8, 256]
   // B: the subparts' side (coarsest-level voxels) along the slabs' across-grain axis instead of
   // K, even, 0 or [8, 256]; 0 keeps K (cubic subparts). The slabs extrude the xy exemplar along

@@ -23,11 +23,11 @@ namespace solidtex {
 namespace {
 
 // A small but complete setup: 3 levels, N = 7, 48^2 procedural exemplars.
-std::shared_ptr<const Table> small_table(ProceduralKind kind, bool grain_x) {
+std::shared_ptr<const Table> small_table(ProceduralKind kind, bool grain_x, int levels = 3) {
   ExemplarInputs in;
   in.xy = testing::procedural(kind, 48, 48);
   AnalysisParams p;
-  p.levels = 3;
+  p.levels = levels;
   p.neighborhood = 7;
   p.candidates = 8;
   p.pca_dims = 12;
@@ -488,20 +488,21 @@ TEST(SynthesizerQuality, MedoidColorsAreExemplarColorsAndNoBlurrierThanMeans) {
 // it) rises well above the medoid's, and the cut stays exemplar colours, as sharp as the medoid's.
 // So on one image and on a grain layout (three planes, E and E^T: a pair along E^T's rows is
 // a pair along E's columns, so E's pairs cover both).
-void expect_votes_copy_patches(ProceduralKind kind, bool grain_x, double min_gain) {
-  const auto table = small_table(kind, grain_x);
-  const ImageF& e = table->exemplars().plane(Plane::kXY);
-  using Pair = std::array<float, 6>;
-  std::vector<Pair> pairs;
-  for (int y = 0; y < e.height; ++y)
-    for (int x = 0; x < e.width; ++x)
-      for (const auto& [dx, dy] : {std::pair{1, 0}, std::pair{0, 1}}) {
-        const float* a = e.wrapped(x, y);
-        const float* b = e.wrapped(x + dx, y + dy);
-        pairs.push_back({a[0], a[1], a[2], b[0], b[1], b[2]});
-      }
-  std::sort(pairs.begin(), pairs.end());
-  auto continuity = [&](const std::vector<std::array<float, 3>>& rgb, int w, int h) {
+// The share of a w x h cut's neighbouring pixel pairs (along x and y) that are neighbouring
+// pixels of exemplar `e` (along its x or y, in that order): how much of the cut is copied patches.
+class ExemplarPairs {
+ public:
+  explicit ExemplarPairs(const ImageF& e) {
+    for (int y = 0; y < e.height; ++y)
+      for (int x = 0; x < e.width; ++x)
+        for (const auto& [dx, dy] : {std::pair{1, 0}, std::pair{0, 1}}) {
+          const float* a = e.wrapped(x, y);
+          const float* b = e.wrapped(x + dx, y + dy);
+          pairs_.push_back({a[0], a[1], a[2], b[0], b[1], b[2]});
+        }
+    std::sort(pairs_.begin(), pairs_.end());
+  }
+  double share(const std::vector<std::array<float, 3>>& rgb, int w, int h) const {
     int64_t in = 0, all = 0;
     for (int y = 0; y < h; ++y)
       for (int x = 0; x < w; ++x)
@@ -509,21 +510,32 @@ void expect_votes_copy_patches(ProceduralKind kind, bool grain_x, double min_gai
           if (x + dx >= w || y + dy >= h) continue;
           const auto& a = rgb[size_t(y) * w + x];
           const auto& b = rgb[size_t(y + dy) * w + x + dx];
-          in += std::binary_search(pairs.begin(), pairs.end(), Pair{a[0], a[1], a[2], b[0], b[1], b[2]});
+          in += std::binary_search(pairs_.begin(), pairs_.end(), Pair{a[0], a[1], a[2], b[0], b[1], b[2]});
           ++all;
         }
     return double(in) / double(all);
-  };
+  }
+
+ private:
+  using Pair = std::array<float, 6>;
+  std::vector<Pair> pairs_;
+};
+
+void expect_votes_copy_patches(ProceduralKind kind, bool grain_x, double min_gain) {
+  const auto table = small_table(kind, grain_x);
+  const ImageF& e = table->exemplars().plane(Plane::kXY);
+  const ExemplarPairs pairs(e);
   double cont[2] = {0, 0}, sharp[2] = {0, 0};
   for (const ColorRule rule : {ColorRule::kMedoid, ColorRule::kVote}) {
     SynthesisParams p = small_params();
     p.passes = SynthesisParams{}.passes;
     p.color = rule;
+    p.finest_match = FinestMatch::kTriple;  // votes measured against medoids on the same triples
     auto s = make(table, "identity", p, 0);
     const int i = rule == ColorRule::kVote;
     for (char axis : {'x', 'z'}) {
       const auto rgb = cut(*s, axis, 7, 0, 0, 40, 40);
-      cont[i] += continuity(rgb, 40, 40) / 2;
+      cont[i] += pairs.share(rgb, 40, 40) / 2;
       sharp[i] += sharpness_ratio(rgb_image(rgb, 40, 40), e) / 2;
     }
   }
@@ -616,6 +628,93 @@ TEST(SynthesizerQuality, VoteColorsCopyExemplarPatchesWhereMedoidsMakeAMosaic) {
   // votes pool); sharpness 1.05 -> 1.06 and 1.17 -> 1.22.
   expect_votes_copy_patches(ProceduralKind::kPebbles, false, 3.0);
   expect_votes_copy_patches(ProceduralKind::kWood, true, 2.5);
+}
+
+// finest_match auto is plane-wise on tables of three or more levels and triples on two-level
+// tables; given values are themselves. Plane-wise matching changes the finest level only (the
+// coarser levels' voxels are the same bits), and a default synthesizer's cut is the resolved
+// rule's, bit for bit.
+TEST(SynthesizerFinestMatch, AutoIsPlaneWiseFromThreeLevelsAndTouchesTheFinestLevelOnly) {
+  const auto three = small_table(ProceduralKind::kPebbles, false);
+  const auto two = small_table(ProceduralKind::kPebbles, false, 2);
+  ASSERT_EQ(three->levels(), 3);
+  ASSERT_EQ(two->levels(), 2);
+  EXPECT_EQ(SynthesisParams{}.finest_match, FinestMatch::kAuto);
+  EXPECT_EQ(resolved_finest_match(*three, FinestMatch::kAuto), FinestMatch::kPlane);
+  EXPECT_EQ(resolved_finest_match(*two, FinestMatch::kAuto), FinestMatch::kTriple);
+  for (const FinestMatch m : {FinestMatch::kTriple, FinestMatch::kPlane}) {
+    EXPECT_EQ(resolved_finest_match(*three, m), m);
+    EXPECT_EQ(resolved_finest_match(*two, m), m);
+    EXPECT_EQ(parse_finest_match(finest_match_name(m)).value(), m);
+  }
+  EXPECT_EQ(parse_finest_match("auto").value(), FinestMatch::kAuto);
+  EXPECT_EQ(parse_finest_match("triples").status().field(), "finest_match");
+
+  auto at_level = [](const std::shared_ptr<const Table>& table, FinestMatch m, int level) {
+    SynthesisParams p = small_params();
+    p.finest_match = m;
+    SynthesisOptions o;
+    o.level = level;
+    o.max_bytes = int64_t(1) << 30;
+    auto r = make(table, "identity", p)->synthesize(TargetSet::box({0, 0, 0}, 12, 12, 1).value(), null_interrupter(),
+                                                    nullptr, o);
+    EXPECT_TRUE(r.is_ok()) << r.status().to_string();
+    return r.is_ok() ? *r : std::vector<std::array<float, 3>>{};
+  };
+  EXPECT_EQ(at_level(three, FinestMatch::kPlane, 1), at_level(three, FinestMatch::kTriple, 1)) << "a coarser level changed";
+  EXPECT_NE(at_level(three, FinestMatch::kPlane, 2), at_level(three, FinestMatch::kTriple, 2)) << "the finest level did not change";
+  EXPECT_EQ(at_level(three, FinestMatch::kAuto, 2), at_level(three, FinestMatch::kPlane, 2));
+  EXPECT_EQ(at_level(two, FinestMatch::kAuto, 1), at_level(two, FinestMatch::kTriple, 1));
+  EXPECT_NE(at_level(two, FinestMatch::kPlane, 1), at_level(two, FinestMatch::kTriple, 1));
+}
+
+// Plane-wise matching at the finest level keeps every plane's coordinates continuing a
+// neighbour's patch, where whole triples continue one plane's and restart the other two: in a z
+// cut's finest triples, the share of neighbour pairs (along an axis the plane contains) whose
+// plane coordinates differ by exactly that step rises from a mosaic's to a patchwork's, and the
+// cut stays as sharp (docs/quality.md, "The finest level matches plane by plane": 13-17 % -> 58-62 %
+// on the shared pebbles, bench_coherence).
+TEST(SynthesizerQuality, PlaneWiseFinestMatchContinuesPatchesInEveryPlane) {
+  const auto table = small_table(ProceduralKind::kPebbles, false);
+  const ImageF& e = table->exemplars().plane(Plane::kXY);
+  const PyramidLevel finest{table->levels() - 1};
+  constexpr int n = 40, z = 7;
+  std::vector<Voxel> voxels;
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x) voxels.push_back({x, y, z});
+  double coherent[2][3] = {}, sharp[2] = {};
+  for (const FinestMatch m : {FinestMatch::kTriple, FinestMatch::kPlane}) {
+    SynthesisParams p = small_params();
+    p.passes = SynthesisParams{}.passes;
+    p.finest_match = m;
+    auto s = make(table, "identity", p);
+    const auto rgb = cut(*s, 'z', z, 0, 0, n, n);
+    const int i = m == FinestMatch::kPlane;
+    sharp[i] = sharpness_ratio(rgb_image(rgb, n, n), e);
+    std::vector<CoordinateTriple> triples;
+    std::vector<uint8_t> found;
+    s->cache().lookup(finest, voxels, triples, found);
+    ASSERT_EQ(std::count(found.begin(), found.end(), uint8_t(1)), int64_t(voxels.size())) << "the cut's triples are not cached";
+    for (int plane = 0; plane < 3; ++plane) {
+      int64_t pairs = 0, same = 0;
+      for (int axis = 0; axis < 2; ++axis) {  // world x, world y
+        const ExemplarPixel step{kPlaneFirstAxis[size_t(plane)] == axis ? 1 : 0, kPlaneSecondAxis[size_t(plane)] == axis ? 1 : 0};
+        if (step.x == 0 && step.y == 0) continue;  // the plane does not contain this axis
+        for (int y = 0; y + (axis == 1) < n; ++y)
+          for (int x = 0; x + (axis == 0) < n; ++x) {
+            const size_t a = size_t(y) * n + x, b = a + (axis == 0 ? 1 : size_t(n));
+            const ExemplarPixel pa = triples[a].at[size_t(plane)], pb = triples[b].at[size_t(plane)];
+            same += ImageF::wrap(pa.x + step.x, e.width) == pb.x && ImageF::wrap(pa.y + step.y, e.height) == pb.y;
+            ++pairs;
+          }
+      }
+      coherent[i][plane] = double(same) / double(pairs);
+    }
+  }
+  std::printf("coherent pairs xy / yz / zx: triple %.3f / %.3f / %.3f, plane %.3f / %.3f / %.3f; sharpness: triple %.3f, plane %.3f\n",
+              coherent[0][0], coherent[0][1], coherent[0][2], coherent[1][0], coherent[1][1], coherent[1][2], sharp[0], sharp[1]);
+  for (int plane = 0; plane < 3; ++plane) EXPECT_GT(coherent[1][plane], 2 * coherent[0][plane]) << plane;
+  EXPECT_GT(sharp[1], 0.9 * sharp[0]);
 }
 
 // Luminance autocorrelation of an image at `lag` pixels along its rows (x) and along its

@@ -125,63 +125,71 @@ def test_healthz_says_stopping_with_503_during_shutdown(server, exemplars):
 
 def test_volumes_stored_before_a_default_changed_keep_their_voxels(server, exemplars):
     """New volumes pin the appearance-changing defaults they were made with (typicality, fine
-    passes, init, color, finest_subpass_size, balance, finest_typicality_scale, init_band); a volume.json
+    passes, init, color, finest_subpass_size, balance, finest_typicality_scale, init_band, finest_match); a volume.json
     written before those were pinned (none anywhere) comes back with the values its voxels were
     synthesized with (typicality 0, two passes, slab init, mean colors, 8 finest subpasses, no
-    usage balance, the same typicality at the finest level, cubic slab subparts), and one written
-    at each later era (typicality, 0.5 until auto, and passes pinned; then init; then color; then
-    finest_subpass_size; then balance; then finest_typicality_scale) with the older values of the
+    usage balance, the same typicality at the finest level, cubic slab subparts, whole triples at
+    the finest level), and one written at each later era (typicality, 0.5 until auto, and passes
+    pinned; then init; then color; then finest_subpass_size; then balance; then
+    finest_typicality_scale; then init_band) with the older values of the
     keys it lacks: no release changes a stored volume's look."""
     a = server()
     c = a.client
     ex = upload_ready(c, exemplars["spots"])
     vol = c.create_volume(exemplar=ex["id"], seed=4)
     assert vol["params"] == {"typicality": "auto", "passes": 1, "init": "auto", "color": "auto", "finest_subpass_size": 1,
-                             "balance": 1.0, "finest_typicality_scale": 0.7, "init_band": 8}, vol
+                             "balance": 1.0, "finest_typicality_scale": 0.7, "init_band": 8,
+                             "finest_match": "auto"}, vol
     # typicality auto is 0.5 on one image (on three planes 0.35: test_robustness.py)
     half = c.create_volume(exemplar=ex["id"], seed=4, params={"typicality": 0.5})
     assert np.array_equal(c.slice(vol["id"], "z", 2, (24, 24)), c.slice(half["id"], "z", 2, (24, 24)))
     legacy = c.create_volume(exemplar=ex["id"], seed=4, params={"typicality": 0, "passes": 2, "init": "slab", "color": "mean",
                                                                     "finest_subpass_size": 2, "balance": 0,
-                                                                    "finest_typicality_scale": 1, "init_band": 0})
+                                                                    "finest_typicality_scale": 1, "init_band": 0, "finest_match": "triple"})
     want = c.slice(legacy["id"], "z", 2, (24, 24))
     assert not np.array_equal(c.slice(vol["id"], "z", 2, (24, 24)), want), "the defaults changed nothing"
     # made when typicality (0.5, before auto) and passes were pinned but init was not
     middle = c.create_volume(exemplar=ex["id"], seed=5, params={"typicality": 0.5})
     slab = c.create_volume(exemplar=ex["id"], seed=5, params={"init": "slab", "color": "mean", "finest_subpass_size": 2,
-                                                                "balance": 0, "finest_typicality_scale": 1, "init_band": 0})
+                                                                "balance": 0, "finest_typicality_scale": 1, "init_band": 0, "finest_match": "triple"})
     want_middle = c.slice(slab["id"], "z", 2, (24, 24))
     assert not np.array_equal(c.slice(middle["id"], "z", 2, (24, 24)), want_middle), "init changed nothing"
     # made when init was pinned but color was not
     late = c.create_volume(exemplar=ex["id"], seed=6, params={"typicality": 0.5})
     mean = c.create_volume(exemplar=ex["id"], seed=6, params={"color": "mean", "finest_subpass_size": 2, "balance": 0,
-                                                              "finest_typicality_scale": 1, "init_band": 0})
+                                                              "finest_typicality_scale": 1, "init_band": 0, "finest_match": "triple"})
     want_late = c.slice(mean["id"], "z", 2, (24, 24))
     assert not np.array_equal(c.slice(late["id"], "z", 2, (24, 24)), want_late), "color changed nothing"
     # made when color was pinned but finest_subpass_size was not
     # (color was medoid by default then; it is pinned, so a later default changes nothing stored)
     recent = c.create_volume(exemplar=ex["id"], seed=7, params={"typicality": 0.5, "color": "medoid"})
     eight = c.create_volume(exemplar=ex["id"], seed=7, params={"color": "medoid", "finest_subpass_size": 2, "balance": 0,
-                                                               "finest_typicality_scale": 1, "init_band": 0})
+                                                               "finest_typicality_scale": 1, "init_band": 0, "finest_match": "triple"})
     want_recent = c.slice(eight["id"], "z", 2, (24, 24))
     assert not np.array_equal(c.slice(recent["id"], "z", 2, (24, 24)), want_recent), "subpasses changed nothing"
     # made when finest_subpass_size was pinned but balance was not
     newest = c.create_volume(exemplar=ex["id"], seed=8, params={"typicality": 0.5, "color": "medoid"})
     unbalanced = c.create_volume(exemplar=ex["id"], seed=8, params={"color": "medoid", "balance": 0,
-                                                                     "finest_typicality_scale": 1, "init_band": 0})
+                                                                     "finest_typicality_scale": 1, "init_band": 0, "finest_match": "triple"})
     want_newest = c.slice(unbalanced["id"], "z", 2, (24, 24))
     assert not np.array_equal(c.slice(newest["id"], "z", 2, (24, 24)), want_newest), "balance changed nothing"
     # made when balance was pinned but finest_typicality_scale was not
     balanced = c.create_volume(exemplar=ex["id"], seed=9)
-    same = c.create_volume(exemplar=ex["id"], seed=9, params={"finest_typicality_scale": 1, "init_band": 0})
+    same = c.create_volume(exemplar=ex["id"], seed=9, params={"finest_typicality_scale": 1, "init_band": 0, "finest_match": "triple"})
     want_balanced = c.slice(same["id"], "z", 2, (24, 24))
     assert not np.array_equal(c.slice(balanced["id"], "z", 2, (24, 24)), want_balanced), "the finest scale changed nothing"
     # made when finest_typicality_scale was pinned but init_band was not (slab init: bands change its
     # subparts; the 48^2 cut crosses a band seam, 8 coarsest voxels of spacing 4 from the origin)
     scaled = c.create_volume(exemplar=ex["id"], seed=10, params={"init": "slab"})
-    cubic = c.create_volume(exemplar=ex["id"], seed=10, params={"init": "slab", "init_band": 0})
+    cubic = c.create_volume(exemplar=ex["id"], seed=10, params={"init": "slab", "init_band": 0, "finest_match": "triple"})
     want_scaled = c.slice(cubic["id"], "z", 2, (48, 48))
     assert not np.array_equal(c.slice(scaled["id"], "z", 2, (48, 48)), want_scaled), "the init band changed nothing"
+    # made when init_band was pinned but finest_match was not (auto is plane-wise on this
+    # three-level table; before, the finest level matched whole triples)
+    banded = c.create_volume(exemplar=ex["id"], seed=11)
+    tripled = c.create_volume(exemplar=ex["id"], seed=11, params={"finest_match": "triple"})
+    want_banded = c.slice(tripled["id"], "z", 2, (24, 24))
+    assert not np.array_equal(c.slice(banded["id"], "z", 2, (24, 24)), want_banded), "the finest match changed nothing"
     assert a.stop(grace=10) == 0
     def forget(volume_id, *keys):
         """Rewrites the stored volume.json as a release that did not pin `keys` wrote it (no
@@ -196,38 +204,43 @@ def test_volumes_stored_before_a_default_changed_keep_their_voxels(server, exemp
         path.write_text(json.dumps(info))
 
     forget(vol["id"])
-    forget(middle["id"], "init", "color", "finest_subpass_size", "balance", "finest_typicality_scale", "init_band")
-    forget(late["id"], "color", "finest_subpass_size", "balance", "finest_typicality_scale", "init_band")
-    forget(recent["id"], "finest_subpass_size", "balance", "finest_typicality_scale", "init_band")
-    forget(newest["id"], "balance", "finest_typicality_scale", "init_band")
-    forget(balanced["id"], "finest_typicality_scale", "init_band")
-    forget(scaled["id"], "init_band")
+    forget(middle["id"], "init", "color", "finest_subpass_size", "balance", "finest_typicality_scale", "init_band", "finest_match")
+    forget(late["id"], "color", "finest_subpass_size", "balance", "finest_typicality_scale", "init_band", "finest_match")
+    forget(recent["id"], "finest_subpass_size", "balance", "finest_typicality_scale", "init_band", "finest_match")
+    forget(newest["id"], "balance", "finest_typicality_scale", "init_band", "finest_match")
+    forget(balanced["id"], "finest_typicality_scale", "init_band", "finest_match")
+    forget(scaled["id"], "init_band", "finest_match")
+    forget(banded["id"], "finest_match")
     b = server(data_dir=a.data_dir)
     got = b.client.get_volume(vol["id"])
     assert got["params"] == {"typicality": 0, "passes": 2, "init": "slab", "color": "mean", "finest_subpass_size": 2,
-                             "balance": 0, "finest_typicality_scale": 1, "init_band": 0}, got
+                             "balance": 0, "finest_typicality_scale": 1, "init_band": 0, "finest_match": "triple"}, got
     assert np.array_equal(b.client.slice(vol["id"], "z", 2, (24, 24)), want)
     got = b.client.get_volume(middle["id"])
     assert got["params"] == {"typicality": 0.5, "passes": 1, "init": "slab", "color": "mean", "finest_subpass_size": 2,
-                             "balance": 0, "finest_typicality_scale": 1, "init_band": 0}, got
+                             "balance": 0, "finest_typicality_scale": 1, "init_band": 0, "finest_match": "triple"}, got
     assert np.array_equal(b.client.slice(middle["id"], "z", 2, (24, 24)), want_middle)
     got = b.client.get_volume(late["id"])
     assert got["params"] == {"typicality": 0.5, "passes": 1, "init": "auto", "color": "mean", "finest_subpass_size": 2,
-                             "balance": 0, "finest_typicality_scale": 1, "init_band": 0}, got
+                             "balance": 0, "finest_typicality_scale": 1, "init_band": 0, "finest_match": "triple"}, got
     assert np.array_equal(b.client.slice(late["id"], "z", 2, (24, 24)), want_late)
     got = b.client.get_volume(recent["id"])
     assert got["params"] == {"typicality": 0.5, "passes": 1, "init": "auto", "color": "medoid", "finest_subpass_size": 2,
-                             "balance": 0, "finest_typicality_scale": 1, "init_band": 0}, got
+                             "balance": 0, "finest_typicality_scale": 1, "init_band": 0, "finest_match": "triple"}, got
     assert np.array_equal(b.client.slice(recent["id"], "z", 2, (24, 24)), want_recent)
     got = b.client.get_volume(newest["id"])
     assert got["params"] == {"typicality": 0.5, "passes": 1, "init": "auto", "color": "medoid", "finest_subpass_size": 1,
-                             "balance": 0, "finest_typicality_scale": 1, "init_band": 0}, got
+                             "balance": 0, "finest_typicality_scale": 1, "init_band": 0, "finest_match": "triple"}, got
     assert np.array_equal(b.client.slice(newest["id"], "z", 2, (24, 24)), want_newest)
     got = b.client.get_volume(balanced["id"])
     assert got["params"] == {"typicality": "auto", "passes": 1, "init": "auto", "color": "auto", "finest_subpass_size": 1,
-                             "balance": 1.0, "finest_typicality_scale": 1, "init_band": 0}, got
+                             "balance": 1.0, "finest_typicality_scale": 1, "init_band": 0, "finest_match": "triple"}, got
     assert np.array_equal(b.client.slice(balanced["id"], "z", 2, (24, 24)), want_balanced)
     got = b.client.get_volume(scaled["id"])
     assert got["params"] == {"typicality": "auto", "passes": 1, "init": "slab", "color": "auto", "finest_subpass_size": 1,
-                             "balance": 1.0, "finest_typicality_scale": 0.7, "init_band": 0}, got
+                             "balance": 1.0, "finest_typicality_scale": 0.7, "init_band": 0, "finest_match": "triple"}, got
     assert np.array_equal(b.client.slice(scaled["id"], "z", 2, (48, 48)), want_scaled)
+    got = b.client.get_volume(banded["id"])
+    assert got["params"] == {"typicality": "auto", "passes": 1, "init": "auto", "color": "auto", "finest_subpass_size": 1,
+                             "balance": 1.0, "finest_typicality_scale": 0.7, "init_band": 8, "finest_match": "triple"}, got
+    assert np.array_equal(b.client.slice(banded["id"], "z", 2, (24, 24)), want_banded)

@@ -186,6 +186,16 @@ def test_init_band_takes_0_or_an_even_side_from_8_to_256_only(srv):
     takes_its_values_only(srv, "init_band", (0, 8, 256), 8, (-2, 2, 6, 9, 258, 1e9, 8.5, "8", None, [8]))
 
 
+def test_finest_match_takes_its_three_names_only(srv):
+    # auto (the default, pinned when absent), triple and plane synthesize; this exemplar's table
+    # has three levels (support.ANALYSIS), where auto is plane-wise (on two levels it is triple:
+    # synthesizer_test.cpp); a given name is itself, and the two rules make different voxels
+    cuts = takes_its_values_only(srv, "finest_match", ("auto", "triple", "plane"), "auto",
+                                 ("planes", "Plane", "", 0, None, ["plane"], {"rule": "plane"}))
+    assert cuts["auto"] == cuts["plane"]
+    assert cuts["triple"] != cuts["plane"]
+
+
 def test_color_takes_its_four_names_only(srv):
     # auto (the default: vote, also on this grained exemplar), vote, medoid and mean
     # synthesize the same triples and differ in colors only
