@@ -64,8 +64,9 @@ enum class FinestMatch {
             // other two planes' coordinates start anew (cuts are mosaics of 1-2 voxel pieces)
   kPlane,   // each plane's coordinate on its own: the current one or a neighbour's in that plane
             // continued into the voxel, whichever matches that plane's neighbourhood best (2D
-            // k-coherence in every plane). The three pixels may then disagree; the output color
-            // rule (vote) picks one, and the finest level's matching colors feed nothing finer
+            // k-coherence in every plane). The three pixels may then disagree: the output color
+            // rule (vote) picks one, and their mean, the matching color, feeds only the finest
+            // level's own later passes (one by default), nothing finer
   kAuto,    // resolved_finest_match() (correction.h)
 };
 Result<FinestMatch> parse_finest_match(const std::string& name);
