@@ -63,6 +63,17 @@ std::vector<std::array<float, 3>> cut(Synthesizer& s, char axis, int at, int u, 
   return r.is_ok() ? *r : std::vector<std::array<float, 3>>{};
 }
 
+// The colors of a 12 x 12 x 1 box of voxels of pyramid level `level` at the origin (its output
+// colors, SynthesisOptions::level): what a parameter changes at that level.
+std::vector<std::array<float, 3>> level_box(const std::shared_ptr<const Table>& table, const SynthesisParams& p, int level) {
+  SynthesisOptions o;
+  o.level = level;
+  o.max_bytes = int64_t(1) << 30;
+  auto r = make(table, "identity", p)->synthesize(TargetSet::box({0, 0, 0}, 12, 12, 1).value(), null_interrupter(), nullptr, o);
+  EXPECT_TRUE(r.is_ok()) << r.status().to_string();
+  return r.is_ok() ? *r : std::vector<std::array<float, 3>>{};
+}
+
 class SynthesizerTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() { table_ = small_table(ProceduralKind::kSpots, false); }
@@ -602,13 +613,7 @@ TEST(SynthesizerTypicality, FinestScaleWeighsTheFinestLevelOnly) {
   auto at_scale = [&](float scale, int level) {
     SynthesisParams p = small_params();
     p.finest_typicality_scale = scale;
-    SynthesisOptions o;
-    o.level = level;
-    o.max_bytes = int64_t(1) << 30;
-    auto r = make(table, "identity", p)->synthesize(TargetSet::box({0, 0, 0}, 12, 12, 1).value(), null_interrupter(),
-                                                    nullptr, o);
-    EXPECT_TRUE(r.is_ok()) << r.status().to_string();
-    return r.is_ok() ? *r : std::vector<std::array<float, 3>>{};
+    return level_box(table, p, level);
   };
   EXPECT_EQ(at_scale(kFinestTypicalityScale, L - 2), at_scale(1.f, L - 2)) << "a coarser level changed";
   EXPECT_NE(at_scale(kFinestTypicalityScale, L - 1), at_scale(1.f, L - 1)) << "the finest level did not change";
@@ -653,13 +658,7 @@ TEST(SynthesizerFinestMatch, AutoIsPlaneWiseFromThreeLevelsAndTouchesTheFinestLe
   auto at_level = [](const std::shared_ptr<const Table>& table, FinestMatch m, int level) {
     SynthesisParams p = small_params();
     p.finest_match = m;
-    SynthesisOptions o;
-    o.level = level;
-    o.max_bytes = int64_t(1) << 30;
-    auto r = make(table, "identity", p)->synthesize(TargetSet::box({0, 0, 0}, 12, 12, 1).value(), null_interrupter(),
-                                                    nullptr, o);
-    EXPECT_TRUE(r.is_ok()) << r.status().to_string();
-    return r.is_ok() ? *r : std::vector<std::array<float, 3>>{};
+    return level_box(table, p, level);
   };
   EXPECT_EQ(at_level(three, FinestMatch::kPlane, 1), at_level(three, FinestMatch::kTriple, 1)) << "a coarser level changed";
   EXPECT_NE(at_level(three, FinestMatch::kPlane, 2), at_level(three, FinestMatch::kTriple, 2)) << "the finest level did not change";
