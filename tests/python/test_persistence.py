@@ -143,9 +143,10 @@ def test_volumes_stored_before_a_default_changed_keep_their_voxels(server, exemp
     # typicality auto is 0.5 on one image (on three planes 0.35: test_robustness.py)
     half = c.create_volume(exemplar=ex["id"], seed=4, params={"typicality": 0.5})
     assert np.array_equal(c.slice(vol["id"], "z", 2, (24, 24)), c.slice(half["id"], "z", 2, (24, 24)))
-    legacy = c.create_volume(exemplar=ex["id"], seed=4, params={"typicality": 0, "passes": 2, "init": "slab", "color": "mean",
-                                                                    "finest_subpass_size": 2, "balance": 0,
-                                                                    "finest_typicality_scale": 1, "init_band": 0, "finest_match": "triple"})
+    # what volumes stored before any of these keys was pinned were made with
+    made_with = {"typicality": 0, "passes": 2, "init": "slab", "color": "mean", "finest_subpass_size": 2, "balance": 0,
+                 "finest_typicality_scale": 1, "init_band": 0, "finest_match": "triple"}
+    legacy = c.create_volume(exemplar=ex["id"], seed=4, params=made_with)
     want = c.slice(legacy["id"], "z", 2, (24, 24))
     assert not np.array_equal(c.slice(vol["id"], "z", 2, (24, 24)), want), "the defaults changed nothing"
     # made when typicality (0.5, before auto) and passes were pinned but init was not
@@ -212,35 +213,21 @@ def test_volumes_stored_before_a_default_changed_keep_their_voxels(server, exemp
     forget(scaled["id"], "init_band", "finest_match")
     forget(banded["id"], "finest_match")
     b = server(data_dir=a.data_dir)
-    got = b.client.get_volume(vol["id"])
-    assert got["params"] == {"typicality": 0, "passes": 2, "init": "slab", "color": "mean", "finest_subpass_size": 2,
-                             "balance": 0, "finest_typicality_scale": 1, "init_band": 0, "finest_match": "triple"}, got
-    assert np.array_equal(b.client.slice(vol["id"], "z", 2, (24, 24)), want)
-    got = b.client.get_volume(middle["id"])
-    assert got["params"] == {"typicality": 0.5, "passes": 1, "init": "slab", "color": "mean", "finest_subpass_size": 2,
-                             "balance": 0, "finest_typicality_scale": 1, "init_band": 0, "finest_match": "triple"}, got
-    assert np.array_equal(b.client.slice(middle["id"], "z", 2, (24, 24)), want_middle)
-    got = b.client.get_volume(late["id"])
-    assert got["params"] == {"typicality": 0.5, "passes": 1, "init": "auto", "color": "mean", "finest_subpass_size": 2,
-                             "balance": 0, "finest_typicality_scale": 1, "init_band": 0, "finest_match": "triple"}, got
-    assert np.array_equal(b.client.slice(late["id"], "z", 2, (24, 24)), want_late)
-    got = b.client.get_volume(recent["id"])
-    assert got["params"] == {"typicality": 0.5, "passes": 1, "init": "auto", "color": "medoid", "finest_subpass_size": 2,
-                             "balance": 0, "finest_typicality_scale": 1, "init_band": 0, "finest_match": "triple"}, got
-    assert np.array_equal(b.client.slice(recent["id"], "z", 2, (24, 24)), want_recent)
-    got = b.client.get_volume(newest["id"])
-    assert got["params"] == {"typicality": 0.5, "passes": 1, "init": "auto", "color": "medoid", "finest_subpass_size": 1,
-                             "balance": 0, "finest_typicality_scale": 1, "init_band": 0, "finest_match": "triple"}, got
-    assert np.array_equal(b.client.slice(newest["id"], "z", 2, (24, 24)), want_newest)
-    got = b.client.get_volume(balanced["id"])
-    assert got["params"] == {"typicality": "auto", "passes": 1, "init": "auto", "color": "auto", "finest_subpass_size": 1,
-                             "balance": 1.0, "finest_typicality_scale": 1, "init_band": 0, "finest_match": "triple"}, got
-    assert np.array_equal(b.client.slice(balanced["id"], "z", 2, (24, 24)), want_balanced)
-    got = b.client.get_volume(scaled["id"])
-    assert got["params"] == {"typicality": "auto", "passes": 1, "init": "slab", "color": "auto", "finest_subpass_size": 1,
-                             "balance": 1.0, "finest_typicality_scale": 0.7, "init_band": 0, "finest_match": "triple"}, got
-    assert np.array_equal(b.client.slice(scaled["id"], "z", 2, (48, 48)), want_scaled)
-    got = b.client.get_volume(banded["id"])
-    assert got["params"] == {"typicality": "auto", "passes": 1, "init": "auto", "color": "auto", "finest_subpass_size": 1,
-                             "balance": 1.0, "finest_typicality_scale": 0.7, "init_band": 8, "finest_match": "triple"}, got
-    assert np.array_equal(b.client.slice(banded["id"], "z", 2, (24, 24)), want_banded)
+    # each era's volume comes back with the values it pinned, and for every key it lacks the
+    # value its voxels were made with
+    eras = [(vol, {}, want, 24),
+            (middle, {"typicality": 0.5, "passes": 1}, want_middle, 24),
+            (late, {"typicality": 0.5, "passes": 1, "init": "auto"}, want_late, 24),
+            (recent, {"typicality": 0.5, "passes": 1, "init": "auto", "color": "medoid"}, want_recent, 24),
+            (newest, {"typicality": 0.5, "passes": 1, "init": "auto", "color": "medoid", "finest_subpass_size": 1},
+             want_newest, 24),
+            (balanced, {"typicality": "auto", "passes": 1, "init": "auto", "color": "auto", "finest_subpass_size": 1,
+                        "balance": 1.0}, want_balanced, 24),
+            (scaled, {"typicality": "auto", "passes": 1, "color": "auto", "finest_subpass_size": 1, "balance": 1.0,
+                      "finest_typicality_scale": 0.7}, want_scaled, 48),
+            (banded, {"typicality": "auto", "passes": 1, "init": "auto", "color": "auto", "finest_subpass_size": 1,
+                      "balance": 1.0, "finest_typicality_scale": 0.7, "init_band": 8}, want_banded, 24)]
+    for volume, pinned, pixels, side in eras:
+        got = b.client.get_volume(volume["id"])
+        assert got["params"] == {**made_with, **pinned}, got
+        assert np.array_equal(b.client.slice(volume["id"], "z", 2, (side, side)), pixels), volume["id"]
