@@ -256,6 +256,13 @@ struct ExemplarService::Impl {
     e.state = State::kRunning;  // another replica's, as far as this one knows
     const auto lease = read_lease(id);
     if (!lease || !orphaned(*lease)) return;
+    // The owner writes the result before it releases the lease, so a lease missing now may be a
+    // job that finished since the look above: look for its result again before taking it over.
+    if (!lease->present) {
+      const auto finished = store.exists(ResourceKind::kExemplar, id, "result.json");
+      if (!finished) return;
+      if (*finished) return adopt_locked(id, e, report);
+    }
     if (attempts(id) >= kMaxAnalysisAttempts) {
       const json record{{"error", status_json(Status(StatusCode::kInternal,
                                                      "the analysis was interrupted " + std::to_string(kMaxAnalysisAttempts) +
