@@ -3,6 +3,7 @@
 built from a striped exemplar score on bench_quality's four cuts, scored the same way.
 
   bench_reference_solids.py [--size 256] [--exemplars a.png:x,b.png:y] [--embark-cache F]
+                            [--sweep [--sweep-values 0.4,0.55,...]]
 
 A grain layout (`solidtex analyze --grain x|y`) asks two planes for the stripes and the third
 for the end grain, an image of E, too. No solid meets all three (docs/quality.md, "How the
@@ -20,6 +21,14 @@ grain y), and each solid says which exemplar coordinate across the stripes a vox
   sheets+45/√2  sheets+45 with E's stripe spacing measured along the sheets' normal:
                 (across + z)/√2; every axis cut shows stripes √2 wider.
   layers        sheets normal to z: z. The z cut is one stripe's colour.
+
+--sweep scores a family instead, every tilt and spacing of the sheets on a grid: `tilted a,b,±`
+reads across = a * across_axis + b * z and shifts the along-stripes coordinate by
+±(b * across_axis - a * z), so the sheets' normal and spacing are (a, b) and the end grain
+shows E turned and scaled rather than one exemplar column (a = 0, b = 1, +: the x cut of grain
+x is E exactly and its z cut one stripe's colour; b = 0: extruded with a shear along the
+stripes). With --sweep-values V the grid is V x V x {+, -}; the best solid is reported as for
+the named ones.
 
 Cuts and references are bench_quality's: z (xy plane, x right, y down), y (x right, z down), x
 (y right, z down), each scored against the image its plane gets under the layout, oriented as the
@@ -57,13 +66,20 @@ CUT_AXES = {  # pixel (i, j) of a cut is ORIGIN + i * u + j * v
 SQRT2 = float(np.sqrt(2.0))
 
 
-def solid_maps(grain: str) -> dict:
-    """Solid name -> f(x, y, z) -> (exemplar column, exemplar row), for a layout of `grain`.
+def laid_map(grain: str, across_of, shift_of=None):
+    """f(x, y, z) -> (exemplar column, exemplar row): the coordinate across E's stripes is
+    across_of(across axis, z), the one along them the along axis plus shift_of(across axis, z).
     Grain x: E's stripes run along its columns' axis (x), across = y; grain y: across = x."""
+    shift_of = shift_of or (lambda across, z: 0)
+    if grain == "x":
+        return lambda x, y, z: (x + shift_of(y, z), across_of(y, z))
+    return lambda x, y, z: (across_of(x, z), y + shift_of(x, z))
+
+
+def solid_maps(grain: str) -> dict:
+    """Solid name -> f(x, y, z) -> (exemplar column, exemplar row), for a layout of `grain`."""
     def laid(across_of):
-        if grain == "x":
-            return lambda x, y, z: (x, across_of(y, z))
-        return lambda x, y, z: (across_of(x, z), y)
+        return laid_map(grain, across_of)
     return {
         "extruded": laid(lambda across, z: across),
         "sheets+45": laid(lambda across, z: across + z),
@@ -71,6 +87,18 @@ def solid_maps(grain: str) -> dict:
         "sheets+45/√2": laid(lambda across, z: (across + z) / SQRT2),
         "layers": laid(lambda across, z: z),
     }
+
+
+def tilted_maps(grain: str, values: list[float]) -> dict:
+    """--sweep's family: name -> map, sheets with normal and spacing (a, b) across the stripes
+    and E's along-stripes coordinate sheared within them (module docstring)."""
+    maps = {}
+    for a in values:
+        for b in values:
+            for sign in (1, -1):
+                maps[f"tilted {a:g},{b:g},{'+' if sign > 0 else '-'}"] = laid_map(
+                    grain, lambda t, z, a=a, b=b: a * t + b * z, lambda t, z, a=a, b=b, s=sign: s * (b * t - a * z))
+    return maps
 
 
 def cut_references(exemplar: np.ndarray, grain: str) -> dict:
@@ -119,6 +147,9 @@ def main() -> int:
                     help="comma-separated PATH:GRAIN (grain x or y); bare names are looked up in ../shared/data/exemplars")
     ap.add_argument("--embark-cache", type=Path, help="bench_quality's Embark scores file, for worst / Embark")
     ap.add_argument("--keep", type=Path, help="keep the cuts' PNGs in this directory")
+    ap.add_argument("--sweep", action="store_true", help="score the tilted family (module docstring) instead of the named solids")
+    ap.add_argument("--sweep-values", default="0.4,0.55,0.7,0.85,1,1.15,1.3",
+                    help="comma-separated values of a and b for --sweep")
     args = ap.parse_args()
     if not (SHARED / "tools" / "texmetric.py").is_file():
         print(f"bench_reference_solids: {SHARED / 'tools' / 'texmetric.py'} not found", file=sys.stderr)
@@ -140,9 +171,10 @@ def main() -> int:
                      "axis_autocorrelation_gap": axis_autocorrelation_gap(exemplar), "solids": {}}
             reference = embark.get(embark_key(path.stem, args.size, 1), {}).get("swd")
             references = write_references(exemplar, grain, tmp, path.stem)
-            for solid_name, solid in solid_maps(grain).items():
+            maps = tilted_maps(grain, [float(v) for v in args.sweep_values.split(",")]) if args.sweep else solid_maps(grain)
+            for solid_name, solid in maps.items():
                 cuts = score_solid(sys.executable, exemplar, solid, references, args.size, tmp,
-                                   f"{path.stem}_{solid_name.replace('/', '_')}")
+                                   f"{path.stem}_{solid_name.replace('/', '_').replace(' ', '_').replace(',', '_')}")
                 worst = max(c["swd"] for c in cuts.values())
                 entry["solids"][solid_name] = {
                     "cuts": cuts,

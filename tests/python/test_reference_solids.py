@@ -53,6 +53,29 @@ def test_tilted_sheets_show_the_exemplar_on_both_striped_cuts_and_not_on_the_end
     assert not np.array_equal(end[:, 1:], end[:, :-1])
 
 
+@pytest.mark.parametrize("grain", ["x", "y"])
+def test_tilted_sheets_turn_the_exemplar_onto_the_end_grain_and_off_the_z_cut(grain):
+    """--sweep's family at a = 0, b = 1: the sheets lie normal to z with E's along-stripes axis
+    on the end-grain cut's other axis, so the end grain is its reference exactly and the z cut
+    shows one exemplar line (a row for grain x, a column for grain y), sheared."""
+    e = striped_exemplar(across_rows=grain == "x")
+    maps = refs.tilted_maps(grain, [0.0, 1.0])
+    assert len(maps) == 8
+    end_grain = "x" if grain == "x" else "y"
+    u, v = refs.CUT_AXES[end_grain]
+    ref = refs.cut_references(e, grain)[end_grain]
+    image = refs.render_cut(e, maps["tilted 0,1,+"], u, v, 48)
+    h, w, _ = ref.shape
+    assert any(np.array_equal(image, tiled(np.roll(ref, (dy, dx), (0, 1)), 48)) for dy in range(h) for dx in range(w))
+    u, v = refs.CUT_AXES["z"]
+    z_cut = refs.render_cut(e, maps["tilted 0,1,+"], u, v, 48)
+    assert np.array_equal(z_cut[1:, :-1], z_cut[:-1, 1:])  # each row the previous one shifted by one
+    assert not np.array_equal(z_cut[1:], z_cut[:-1])
+    # The other sign turns the end grain the other way: not the reference.
+    turned = refs.render_cut(e, maps["tilted 0,1,-"], *refs.CUT_AXES[end_grain], 48)
+    assert not any(np.array_equal(turned, tiled(np.roll(ref, (dy, dx), (0, 1)), 48)) for dy in range(h) for dx in range(w))
+
+
 def test_texmetric_scores_the_end_grain_of_sheets_far_from_their_striped_cuts(tmp_path):
     if not (refs.SHARED / "tools" / "texmetric.py").is_file():
         pytest.skip(f"{refs.SHARED / 'tools' / 'texmetric.py'} not found: needs ../shared")
