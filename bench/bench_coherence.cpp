@@ -1,7 +1,7 @@
 // Benchmark (diagnostic, issue #12): how coherent a cut's coordinate triples are, level by
 // level, and how far the three exemplar pixels of a finest triple agree. Prints one JSON object.
 //   bench_coherence TABLE.stx [--size N] [--typicality auto|T] [--passes P] [--finest-subpass-size S]
-//                   [--finest-match auto|triple|plane]
+//                   [--finest-match auto|triple|plane] [--finest-sources cross|square]
 // A z cut N x N (default 128) at z = 0, identity field, default parameters otherwise (the
 // table's suggested plane weights), synthesized twice: as configured, and with no correction
 // at the finer levels (upsampling only: the coarsest level's result carried down). Per level:
@@ -35,6 +35,7 @@ struct Options {
   int passes = SynthesisParams{}.passes;
   int finest_subpass_size = SynthesisParams{}.finest_subpass_size;
   FinestMatch finest_match = SynthesisParams{}.finest_match;
+  FinestSources finest_sources = SynthesisParams{}.finest_sources;
 };
 
 // "auto" is absent (resolved per table), anything else a weight.
@@ -146,10 +147,17 @@ int main(int argc, char** argv) {
         return 2;
       }
       o.finest_match = *m;
+    } else if (a == "--finest-sources" && has_value) {
+      auto m = parse_finest_sources(argv[++i]);
+      if (!m) {
+        std::cerr << m.status().to_string() << "\n";
+        return 2;
+      }
+      o.finest_sources = *m;
     } else if (o.table.empty() && a.rfind("--", 0) != 0) o.table = a;
     else {
       std::cerr << "usage: bench_coherence TABLE.stx [--size N] [--typicality auto|T] [--passes P] [--finest-subpass-size S] "
-                   "[--finest-match auto|triple|plane]\n";
+                   "[--finest-match auto|triple|plane] [--finest-sources cross|square]\n";
       return 2;
     }
   }
@@ -170,6 +178,7 @@ int main(int argc, char** argv) {
     p.passes = corrected ? o.passes : 0;
     p.finest_subpass_size = o.finest_subpass_size;
     p.finest_match = o.finest_match;
+    p.finest_sources = o.finest_sources;
     if (Status s = p.validate(); !s.is_ok()) {
       std::cerr << s.to_string() << "\n";
       return 2;

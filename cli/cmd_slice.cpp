@@ -103,7 +103,8 @@ ImageF axis_cut_exemplar(const Table& table, char axis) {
 Status run_slice(const std::vector<std::string>& argv) {
   Args args({"-o", "--axis", "--at", "--origin", "--plane", "--resample", "--size", "--scheme", "--field", "--seed", "--threads",
              "--stats", "--passes", "--coarse-passes", "--cell", "--cache-mb", "--plane-weights", "--matcher", "--region-table", "--regions",
-             "--typicality", "--finest-typicality-scale", "--balance", "--init", "--init-band", "--color", "--finest-match", "--finest-subpass-size", "--reference"},
+             "--typicality", "--finest-typicality-scale", "--balance", "--init", "--init-band", "--color", "--finest-match", "--finest-sources",
+             "--finest-subpass-size", "--reference"},
             {"--energy"});
   SOLIDTEX_RETURN_IF_ERROR(args.parse(argv));
   if (args.positionals().size() != 1)
@@ -124,6 +125,9 @@ Status run_slice(const std::vector<std::string>& argv) {
   }
   if (auto f = args.get("--finest-match")) {
     SOLIDTEX_ASSIGN_OR_RETURN(params.finest_match, parse_finest_match(*f));
+  }
+  if (auto f = args.get("--finest-sources")) {
+    SOLIDTEX_ASSIGN_OR_RETURN(params.finest_sources, parse_finest_sources(*f));
   }
   if (auto m = args.get("--matcher")) {
     SOLIDTEX_ASSIGN_OR_RETURN(params.matcher, parse_matcher(*m));

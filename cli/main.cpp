@@ -35,7 +35,7 @@ constexpr const char* kUsage =
     "          --size W,H [--scheme plain|subpass|grid|dual-grid] [--field identity|quat:W,X,Y,Z|axis:X,Y,Z,DEG|FILE]\n"
     "          [--seed S] [--threads T] [--typicality auto|T] [--finest-typicality-scale 0.7] [--balance 1]\n"
     "          [--init auto|scatter|slab] [--init-band 8] [--color auto|vote|medoid|mean]\n"
-    "          [--finest-match auto|triple|plane]\n"
+    "          [--finest-match auto|triple|plane] [--finest-sources cross|square]\n"
     "          [--passes 1] [--coarse-passes 3] [--cell 12] [--matcher paper|coherent]\n"
     "          [--plane-weights XY,YZ,ZX] [--cache-mb 256] [--region-table B.stx --regions LABEL]\n"
     "          [--finest-subpass-size 1|2] [--stats STATS.json] [--reference REF.png] [--energy] -o OUT.png\n"

@@ -26,7 +26,8 @@ template <typename P>
 struct Param {
   // std::optional<float>: a number in range, or "auto" for absent (resolved per table).
   using Member = std::variant<int P::*, uint32_t P::*, float P::*, std::optional<float> P::*, std::array<float, 3> P::*,
-                              Scheme P::*, Matcher P::*, Init P::*, ColorRule P::*, FinestMatch P::*>;
+                              Scheme P::*, Matcher P::*, Init P::*, ColorRule P::*, FinestMatch P::*,
+                              FinestSources P::*>;
   const char* key;
   Member member;
   int64_t lo = 0, hi = 0;
@@ -56,6 +57,7 @@ constexpr Param<SynthesisParams> kSynthesisParams[] = {
     {"init", &SynthesisParams::init},
     {"color", &SynthesisParams::color},
     {"finest_match", &SynthesisParams::finest_match},
+    {"finest_sources", &SynthesisParams::finest_sources},
     {"init_subpart", &SynthesisParams::init_subpart, 8, 256},
     {"init_band", &SynthesisParams::init_band, 0, 256},
     {"trilinear_levels", &SynthesisParams::trilinear_levels, 0, 8},
@@ -128,6 +130,7 @@ Status read_param(const Param<P>& d, const json& v, const std::string& field, P&
           [&](Init P::*m) { return read_name(v, field, &parse_init, p.*m); },
           [&](ColorRule P::*m) { return read_name(v, field, &parse_color_rule, p.*m); },
           [&](FinestMatch P::*m) { return read_name(v, field, &parse_finest_match, p.*m); },
+          [&](FinestSources P::*m) { return read_name(v, field, &parse_finest_sources, p.*m); },
       },
       d.member);
 }
@@ -151,6 +154,7 @@ json write_params(const P& p, const Param<P> (&table)[N]) {
                                 [&](Init P::*m) { return json(init_name(p.*m)); },
                                 [&](ColorRule P::*m) { return json(color_rule_name(p.*m)); },
                                 [&](FinestMatch P::*m) { return json(finest_match_name(p.*m)); },
+                                [&](FinestSources P::*m) { return json(finest_sources_name(p.*m)); },
                                 [&](std::optional<float> P::*m) { return p.*m ? shortest(*(p.*m)) : json("auto"); },
                                 [&](float P::*m) { return shortest(p.*m); },
                                 [&](std::array<float, 3> P::*m) {

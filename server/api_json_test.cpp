@@ -32,7 +32,7 @@ TEST(ApiJson, WireFormatOfTheDefaults) {
             R"({"candidates":12,"knn_checks":192,"levels":0,"neighborhood":9,"pca_dims":20,"search_k":24,"seed":1,)"
             R"("suggested_plane_weights":[1.0,1.0,1.0]})");
   EXPECT_EQ(to_json(SynthesisParams{}).dump(),
-            R"({"balance":1.0,"cell_size":12,"coarse_passes":3,"color":"auto","finest_match":"auto","finest_subpass_size":1,"finest_typicality_scale":0.7,"init":"auto","init_band":8,"init_subpart":32,"matcher":"paper","passes":1,)"
+            R"({"balance":1.0,"cell_size":12,"coarse_passes":3,"color":"auto","finest_match":"auto","finest_sources":"cross","finest_subpass_size":1,"finest_typicality_scale":0.7,"init":"auto","init_band":8,"init_subpart":32,"matcher":"paper","passes":1,)"
             R"("plane_weights":[1.0,1.0,1.0],"scheme":"dual-grid","subpass_size":2,"trilinear_levels":2,"typicality":"auto"})");
 }
 
@@ -61,6 +61,7 @@ TEST(ApiJson, EveryKeyReadsBackWhatItWrites) {
   s.init_subpart = 64;
   s.init_band = 0;
   s.finest_match = FinestMatch::kTriple;
+  s.finest_sources = FinestSources::kSquare;
   s.trilinear_levels = 0;
   s.plane_weights = {0.5f, 1.f, 0.f};
   s.typicality = 1.25f;
@@ -135,6 +136,8 @@ TEST(ApiJson, ErrorsNameTheField) {
       {{{"color", "median"}}, "params.color", "unknown color 'median'"},
       {{{"finest_match", "triples"}}, "params.finest_match", "unknown finest_match 'triples'"},
       {{{"finest_match", 1}}, "params.finest_match", "must be a string"},
+      {{{"finest_sources", "diagonal"}}, "params.finest_sources", "unknown finest_sources 'diagonal'"},
+      {{{"finest_sources", true}}, "params.finest_sources", "must be a string"},
       {{{"typicality", 5}}, "params.typicality", "must be in [0.000000, 4.000000]"},
       {{{"typicality", "high"}}, "params.typicality", "must be a number or \"auto\""},
       {{{"typicality", "0.5"}}, "params.typicality", "must be a number or \"auto\""},

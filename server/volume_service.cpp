@@ -574,19 +574,20 @@ bool pin_params(json& spec, const json& values) {
 // correction passes, the coarsest level started from slabs, output colors were means, the
 // finest level ran 8 subpasses per pass, usage penalties were not applied, the finest level
 // matched with the same typicality as the others, slab subparts were cubes (init_band 0), and
-// the finest level matched whole triples (finest_match triple).
+// the finest level matched whole triples (finest_match triple), and plane-wise matching continued
+// the 3x3 neighbours (finest_sources square).
 json current_defaults() {
   const json all = to_json(SynthesisParams{});
   json pinned = json::object();
   for (const char* key : {"typicality", "balance", "passes", "init", "color", "finest_subpass_size", "finest_typicality_scale",
-                          "init_band", "finest_match"})
+                          "init_band", "finest_match", "finest_sources"})
     pinned[key] = all.at(key);
   return pinned;
 }
 json legacy_defaults() {
   return {{"typicality", 0.0}, {"passes", 2}, {"init", "slab"}, {"color", "mean"},
           {"finest_subpass_size", 2}, {"balance", 0.0}, {"finest_typicality_scale", 1.0},
-          {"init_band", 0}, {"finest_match", "triple"}};
+          {"init_band", 0}, {"finest_match", "triple"}, {"finest_sources", "square"}};
 }
 
 }  // namespace

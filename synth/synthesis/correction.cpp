@@ -217,6 +217,7 @@ CorrectionContext CorrectionContext::make(const Table& table, PyramidLevel l, co
   ctx.n = table.params().neighborhood;
   ctx.spacing = table.spacing(l);
   ctx.plane_wise = ctx.spacing == 1 && resolved_finest_match(table, params.finest_match) == FinestMatch::kPlane;
+  ctx.cross_sources = ctx.plane_wise && params.finest_sources == FinestSources::kCross;
   ctx.channels = table.exemplars().channels();
   ctx.dims = ctx.level->planes[0]->pca.output_dims;
   for (int k = 0; k < 3; ++k) ctx.projection[size_t(k)] = PcaProjection::of(ctx.level->planes[size_t(k)]->pca);
@@ -314,7 +315,9 @@ CoordinateTriple best_candidate(const CorrectionContext& ctx, const CoordinateTr
       const PlaneAppearance& app = *level.planes[size_t(k)];
       float best_k = cur_terms[size_t(k)];
       ExemplarPixel& pick = cur.at[size_t(k)];
-      for (const ExemplarPixel& raw : sources[size_t(k)]) {
+      for (int ab = 0; ab < 9; ++ab) {
+        if (ctx.cross_sources && ab % 2 == 0 && ab != 4) continue;  // a diagonal neighbour's
+        const ExemplarPixel& raw = sources[size_t(k)][size_t(ab)];
         const ExemplarPixel src{ImageF::wrap(raw.x, app.stack.width), ImageF::wrap(raw.y, app.stack.height)};
         const float t = term[size_t(k)](pixel_index(app, src));
         if (t < best_k || (t == best_k && (src.y < pick.y || (src.y == pick.y && src.x < pick.x)))) {

@@ -13,8 +13,10 @@
 //
 // Plane-wise matching (CorrectionContext::plane_wise; FinestMatch::kPlane at the finest level):
 // the cost is a sum of per-plane terms, so each plane's coordinate is chosen on its own, from
-// its current pixel and its nine sources T_k(u) - h*(a, b), the lowest term winning (equal terms
-// to the smaller (y, x)). Every plane then continues a neighbour's patch in that plane.
+// its current pixel and its sources T_k(u) - h*(a, b), the lowest term winning (equal terms
+// to the smaller (y, x)). Every plane then continues a neighbour's patch in that plane. The
+// sources are the nine (a, b) in {-1,0,1}^2 (FinestSources::kSquare) or the five with a = 0 or
+// b = 0 (kCross, CorrectionContext::cross_sources); every candidate offset is read either way.
 //
 // Candidate set S(v): the voxel's current triple, plus for every plane k and in-plane step
 // (a, b) in {-1,0,1}^2 the N_T table candidates of plane k at T_k(u) - h*(a, b), where
@@ -116,6 +118,8 @@ struct CorrectionContext {
   // Each plane's coordinate chosen on its own (FinestMatch::kPlane at the finest level): the
   // table's candidate lists are not read, only each plane's sources and the current triple.
   bool plane_wise = false;
+  // Plane-wise sources are the voxel and its four edge neighbours (FinestSources::kCross), not the 3x3.
+  bool cross_sources = false;
   PlaneWeights color_weights{1.f / 3, 1.f / 3, 1.f / 3};
   ColorRule color_rule = ColorRule::kMedoid;         // output colors only, resolved (never kAuto)
   float typicality = 0.f;                            // level_typicality()

@@ -52,6 +52,14 @@ const char* finest_match_name(FinestMatch m) {
   return m == FinestMatch::kAuto ? "auto" : m == FinestMatch::kTriple ? "triple" : "plane";
 }
 
+Result<FinestSources> parse_finest_sources(const std::string& name) {
+  if (name == "square") return FinestSources::kSquare;
+  if (name == "cross") return FinestSources::kCross;
+  return Status(StatusCode::kInvalidArgument, "unknown finest_sources '" + name + "' (cross, square)", "finest_sources");
+}
+
+const char* finest_sources_name(FinestSources s) { return s == FinestSources::kSquare ? "square" : "cross"; }
+
 Result<Matcher> parse_matcher(const std::string& name) {
   if (name == "paper") return Matcher::kPaper;
   if (name == "coherent") return Matcher::kCoherent;

@@ -72,6 +72,17 @@ enum class FinestMatch {
 Result<FinestMatch> parse_finest_match(const std::string& name);
 const char* finest_match_name(FinestMatch m);
 
+// Which neighbours' patches plane-wise matching (FinestMatch::kPlane) continues into a voxel, in
+// each plane besides the voxel's own pixel. Triples ignore it.
+enum class FinestSources {
+  kSquare,  // the 3x3 around the voxel in that plane: eight neighbours
+  kCross,   // its four edge neighbours only. Fewer, nearer proposals: the diagonals' continuations
+            // win where they match the neighbourhood a little better yet start seams the eye
+            // and swd see (docs/quality.md, "Plane-wise matching continues edge neighbours")
+};
+Result<FinestSources> parse_finest_sources(const std::string& name);
+const char* finest_sources_name(FinestSources s);
+
 Result<Scheme> parse_scheme(const std::string& name);
 const char* scheme_name(Scheme s);
 
@@ -110,6 +121,9 @@ struct SynthesisParams {
   // How the finest level's correction picks (FinestMatch): auto by default; volumes pin it, and
   // volumes stored before restore with kTriple (bit for bit what they were made with).
   FinestMatch finest_match = FinestMatch::kAuto;
+  // Plane-wise matching's sources (FinestSources): cross by default; volumes pin it, and volumes
+  // stored before restore with kSquare (bit for bit what they were made with).
+  FinestSources finest_sources = FinestSources::kCross;
   int init_subpart = 32;     // K: coarsest-level voxels per slab-initialisation subpart side, even, [8, 256]
   // B: the subparts' side (coarsest-level voxels) along the slabs' across-grain axis instead of
   // K, even, 0 or [8, 256]; 0 keeps K (cubic subparts). The slabs extrude the xy exemplar along

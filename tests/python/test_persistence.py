@@ -125,13 +125,15 @@ def test_healthz_says_stopping_with_503_during_shutdown(server, exemplars):
 
 def test_volumes_stored_before_a_default_changed_keep_their_voxels(server, exemplars):
     """New volumes pin the appearance-changing defaults they were made with (typicality, fine
-    passes, init, color, finest_subpass_size, balance, finest_typicality_scale, init_band, finest_match); a volume.json
+    passes, init, color, finest_subpass_size, balance, finest_typicality_scale, init_band, finest_match,
+    finest_sources); a volume.json
     written before those were pinned (none anywhere) comes back with the values its voxels were
     synthesized with (typicality 0, two passes, slab init, mean colors, 8 finest subpasses, no
     usage balance, the same typicality at the finest level, cubic slab subparts, whole triples at
-    the finest level), and one written at each later era (typicality, 0.5 until auto, and passes
-    pinned; then init; then color; then finest_subpass_size; then balance; then
-    finest_typicality_scale; then init_band) with the older values of the
+    the finest level, the 3x3 sources where it matches plane-wise), and one written at each later
+    era (typicality, 0.5 until auto, and passes pinned; then init; then color; then
+    finest_subpass_size; then balance; then finest_typicality_scale; then init_band; then
+    finest_match) with the older values of the
     keys it lacks: no release changes a stored volume's look."""
     a = server()
     c = a.client
@@ -139,13 +141,13 @@ def test_volumes_stored_before_a_default_changed_keep_their_voxels(server, exemp
     vol = c.create_volume(exemplar=ex["id"], seed=4)
     assert vol["params"] == {"typicality": "auto", "passes": 1, "init": "auto", "color": "auto", "finest_subpass_size": 1,
                              "balance": 1.0, "finest_typicality_scale": 0.7, "init_band": 8,
-                             "finest_match": "auto"}, vol
+                             "finest_match": "auto", "finest_sources": "cross"}, vol
     # typicality auto is 0.5 on one image (on three planes 0.35: test_robustness.py)
     half = c.create_volume(exemplar=ex["id"], seed=4, params={"typicality": 0.5})
     assert np.array_equal(c.slice(vol["id"], "z", 2, (24, 24)), c.slice(half["id"], "z", 2, (24, 24)))
     # what volumes stored before any of these keys was pinned were made with
     made_with = {"typicality": 0, "passes": 2, "init": "slab", "color": "mean", "finest_subpass_size": 2, "balance": 0,
-                 "finest_typicality_scale": 1, "init_band": 0, "finest_match": "triple"}
+                 "finest_typicality_scale": 1, "init_band": 0, "finest_match": "triple", "finest_sources": "square"}
     legacy = c.create_volume(exemplar=ex["id"], seed=4, params=made_with)
     want = c.slice(legacy["id"], "z", 2, (24, 24))
     assert not np.array_equal(c.slice(vol["id"], "z", 2, (24, 24)), want), "the defaults changed nothing"
@@ -191,6 +193,12 @@ def test_volumes_stored_before_a_default_changed_keep_their_voxels(server, exemp
     tripled = c.create_volume(exemplar=ex["id"], seed=11, params={"finest_match": "triple"})
     want_banded = c.slice(tripled["id"], "z", 2, (24, 24))
     assert not np.array_equal(c.slice(banded["id"], "z", 2, (24, 24)), want_banded), "the finest match changed nothing"
+    # made when finest_match was pinned but finest_sources was not (plane-wise matching then
+    # continued the 3x3 neighbours)
+    matched = c.create_volume(exemplar=ex["id"], seed=12)
+    squared = c.create_volume(exemplar=ex["id"], seed=12, params={"finest_sources": "square"})
+    want_matched = c.slice(squared["id"], "z", 2, (24, 24))
+    assert not np.array_equal(c.slice(matched["id"], "z", 2, (24, 24)), want_matched), "the sources changed nothing"
     assert a.stop(grace=10) == 0
     def forget(volume_id, *keys):
         """Rewrites the stored volume.json as a release that did not pin `keys` wrote it (no
@@ -205,13 +213,14 @@ def test_volumes_stored_before_a_default_changed_keep_their_voxels(server, exemp
         path.write_text(json.dumps(info))
 
     forget(vol["id"])
-    forget(middle["id"], "init", "color", "finest_subpass_size", "balance", "finest_typicality_scale", "init_band", "finest_match")
-    forget(late["id"], "color", "finest_subpass_size", "balance", "finest_typicality_scale", "init_band", "finest_match")
-    forget(recent["id"], "finest_subpass_size", "balance", "finest_typicality_scale", "init_band", "finest_match")
-    forget(newest["id"], "balance", "finest_typicality_scale", "init_band", "finest_match")
-    forget(balanced["id"], "finest_typicality_scale", "init_band", "finest_match")
-    forget(scaled["id"], "init_band", "finest_match")
-    forget(banded["id"], "finest_match")
+    forget(middle["id"], "init", "color", "finest_subpass_size", "balance", "finest_typicality_scale", "init_band", "finest_match", "finest_sources")
+    forget(late["id"], "color", "finest_subpass_size", "balance", "finest_typicality_scale", "init_band", "finest_match", "finest_sources")
+    forget(recent["id"], "finest_subpass_size", "balance", "finest_typicality_scale", "init_band", "finest_match", "finest_sources")
+    forget(newest["id"], "balance", "finest_typicality_scale", "init_band", "finest_match", "finest_sources")
+    forget(balanced["id"], "finest_typicality_scale", "init_band", "finest_match", "finest_sources")
+    forget(scaled["id"], "init_band", "finest_match", "finest_sources")
+    forget(banded["id"], "finest_match", "finest_sources")
+    forget(matched["id"], "finest_sources")
     b = server(data_dir=a.data_dir)
     # each era's volume comes back with the values it pinned, and for every key it lacks the
     # value its voxels were made with
@@ -226,7 +235,10 @@ def test_volumes_stored_before_a_default_changed_keep_their_voxels(server, exemp
             (scaled, {"typicality": "auto", "passes": 1, "color": "auto", "finest_subpass_size": 1, "balance": 1.0,
                       "finest_typicality_scale": 0.7}, want_scaled, 48),
             (banded, {"typicality": "auto", "passes": 1, "init": "auto", "color": "auto", "finest_subpass_size": 1,
-                      "balance": 1.0, "finest_typicality_scale": 0.7, "init_band": 8}, want_banded, 24)]
+                      "balance": 1.0, "finest_typicality_scale": 0.7, "init_band": 8}, want_banded, 24),
+            (matched, {"typicality": "auto", "passes": 1, "init": "auto", "color": "auto", "finest_subpass_size": 1,
+                       "balance": 1.0, "finest_typicality_scale": 0.7, "init_band": 8, "finest_match": "auto"},
+             want_matched, 24)]
     for volume, pinned, pixels, side in eras:
         got = b.client.get_volume(volume["id"])
         assert got["params"] == {**made_with, **pinned}, got

@@ -196,6 +196,14 @@ def test_finest_match_takes_its_three_names_only(srv):
     assert cuts["triple"] != cuts["plane"]
 
 
+def test_finest_sources_takes_its_two_names_only(srv):
+    # cross (the default, pinned when absent) and square synthesize and differ: auto
+    # finest_match is plane-wise on this three-level table, the only matching that reads them
+    cuts = takes_its_values_only(srv, "finest_sources", ("cross", "square"), "cross",
+                                 ("Cross", "diagonal", "", 0, None, ["cross"], {"sources": "cross"}))
+    assert cuts["cross"] != cuts["square"]
+
+
 def test_color_takes_its_four_names_only(srv):
     # auto (the default: vote, also on this grained exemplar), vote, medoid and mean
     # synthesize the same triples and differ in colors only

@@ -323,10 +323,10 @@ def test_old_scheme_name_is_rejected_and_plain_works(shared, tmp_path):
             "--seed", "7", "--scheme", "plain", "-o", out)
     assert np.array_equal(file_pixels(out), png_pixels(png)), "service plain != CLI --scheme plain"
     # the default scheme, dual-grid; the typicality, passes, init, color, subpass, balance, finest scale, init band
-    # and finest match defaults are pinned
+    # finest match and finest sources defaults are pinned
     assert shared.volume["params"] == {"typicality": "auto", "passes": 1, "init": "auto", "color": "auto", "finest_subpass_size": 1,
                                        "balance": 1.0, "finest_typicality_scale": 0.7, "init_band": 8,
-                                       "finest_match": "auto"}, shared.volume
+                                       "finest_match": "auto", "finest_sources": "cross"}, shared.volume
     default = c.slice(shared.volume_id, "z", 3, (32, 24))
     assert not np.array_equal(png_pixels(png), default), "plain and dual-grid gave the same slice"
     c.delete_volume(vol["id"])
