@@ -32,7 +32,7 @@ TEST(ApiJson, WireFormatOfTheDefaults) {
             R"({"candidates":12,"knn_checks":192,"levels":0,"neighborhood":9,"pca_dims":20,"search_k":24,"seed":1,)"
             R"("suggested_plane_weights":[1.0,1.0,1.0]})");
   EXPECT_EQ(to_json(SynthesisParams{}).dump(),
-            R"({"balance":1.0,"cell_size":12,"coarse_passes":3,"color":"auto","finest_match":"auto","finest_sources":"cross","finest_subpass_size":1,"finest_typicality_scale":0.7,"init":"auto","init_band":8,"init_subpart":32,"matcher":"paper","passes":1,)"
+            R"({"balance":1.0,"cell_size":12,"coarse_passes":3,"color":"auto","finest_match":"auto","finest_sources":"square","finest_subpass_size":1,"finest_typicality_scale":0.7,"init":"auto","init_band":8,"init_subpart":32,"matcher":"paper","passes":1,)"
             R"("plane_weights":[1.0,1.0,1.0],"scheme":"dual-grid","subpass_size":2,"trilinear_levels":2,"typicality":"auto"})");
 }
 
@@ -61,7 +61,7 @@ TEST(ApiJson, EveryKeyReadsBackWhatItWrites) {
   s.init_subpart = 64;
   s.init_band = 0;
   s.finest_match = FinestMatch::kTriple;
-  s.finest_sources = FinestSources::kSquare;
+  s.finest_sources = FinestSources::kCross;
   s.trilinear_levels = 0;
   s.plane_weights = {0.5f, 1.f, 0.f};
   s.typicality = 1.25f;

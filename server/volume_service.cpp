@@ -574,8 +574,8 @@ bool pin_params(json& spec, const json& values) {
 // correction passes, the coarsest level started from slabs, output colors were means, the
 // finest level ran 8 subpasses per pass, usage penalties were not applied, the finest level
 // matched with the same typicality as the others, slab subparts were cubes (init_band 0), and
-// the finest level matched whole triples (finest_match triple), and plane-wise matching continued
-// the 3x3 neighbours (finest_sources square).
+// the finest level matched whole triples (finest_match triple). finest_sources has always been
+// square by default; it is pinned so that a later default cannot change a stored volume.
 json current_defaults() {
   const json all = to_json(SynthesisParams{});
   json pinned = json::object();

@@ -76,9 +76,10 @@ const char* finest_match_name(FinestMatch m);
 // each plane besides the voxel's own pixel. Triples ignore it.
 enum class FinestSources {
   kSquare,  // the 3x3 around the voxel in that plane: eight neighbours
-  kCross,   // its four edge neighbours only: fewer, nearer proposals. Measured better on 6 of 9
-            // shared exemplars (stones most), though fewer neighbour pairs continue each other
-            // (docs/quality.md, "Plane-wise matching continues edge neighbours")
+  kCross,   // its four edge neighbours only: fewer, nearer proposals. Over nine samples the
+            // stones' axis cuts 5 % better, the worst of four -1 % on average, but pebbles'
+            // oblique / axis 1.17 -> 1.21, past the issue's 1.2 (docs/quality.md, "Plane-wise
+            // matching from the edge neighbours only"), so it is not the default
 };
 Result<FinestSources> parse_finest_sources(const std::string& name);
 const char* finest_sources_name(FinestSources s);
@@ -121,9 +122,8 @@ struct SynthesisParams {
   // How the finest level's correction picks (FinestMatch): auto by default; volumes pin it, and
   // volumes stored before restore with kTriple (bit for bit what they were made with).
   FinestMatch finest_match = FinestMatch::kAuto;
-  // Plane-wise matching's sources (FinestSources): cross by default; volumes pin it, and volumes
-  // stored before restore with kSquare (bit for bit what they were made with).
-  FinestSources finest_sources = FinestSources::kCross;
+  // Plane-wise matching's sources (FinestSources): square by default; volumes pin it.
+  FinestSources finest_sources = FinestSources::kSquare;
   int init_subpart = 32;     // K: coarsest-level voxels per slab-initialisation subpart side, even, [8, 256]
   // B: the subparts' side (coarsest-level voxels) along the slabs' across-grain axis instead of
   // K, even, 0 or [8, 256]; 0 keeps K (cubic subparts). The slabs extrude the xy exemplar along

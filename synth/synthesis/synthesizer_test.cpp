@@ -667,10 +667,10 @@ TEST(SynthesizerFinestMatch, AutoIsPlaneWiseFromThreeLevelsAndTouchesTheFinestLe
   EXPECT_NE(at_level(two, FinestMatch::kPlane, 1), at_level(two, FinestMatch::kTriple, 1));
 }
 
-// finest_sources: cross by default; it changes plane-wise matching's finest level only, and
-// triples not at all.
-TEST(SynthesizerFinestSources, CrossIsTheDefaultAndChangesPlaneWiseFinestLevelsOnly) {
-  EXPECT_EQ(SynthesisParams{}.finest_sources, FinestSources::kCross);
+// finest_sources: square by default; cross changes plane-wise matching's finest level only,
+// and triples not at all.
+TEST(SynthesizerFinestSources, CrossChangesPlaneWiseFinestLevelsOnly) {
+  EXPECT_EQ(SynthesisParams{}.finest_sources, FinestSources::kSquare);
   for (const FinestSources f : {FinestSources::kSquare, FinestSources::kCross})
     EXPECT_EQ(parse_finest_sources(finest_sources_name(f)).value(), f);
   EXPECT_EQ(parse_finest_sources("diagonal").status().field(), "finest_sources");
@@ -693,10 +693,10 @@ TEST(SynthesizerFinestSources, CrossIsTheDefaultAndChangesPlaneWiseFinestLevelsO
 // cut's finest triples, the share of neighbour pairs (along an axis the plane contains) whose
 // plane coordinates differ by exactly that step rises from a mosaic's to a patchwork's, and the
 // cut stays as sharp (docs/quality.md, "The finest level matches plane by plane": 13-17 % -> 58-62 %
-// on the shared pebbles, bench_coherence), whether the sources are the 3x3 neighbours' or, the
-// default, the four edge neighbours' (cross: 0.50-0.52 here against the 3x3's 0.54-0.55; what
-// cross buys is measured on the shared exemplars, docs/quality.md, "Plane-wise matching
-// continues edge neighbours").
+// on the shared pebbles, bench_coherence), whether the sources are the 3x3 neighbours' (the
+// default) or the four edge neighbours' (cross: 0.50-0.52 here against the 3x3's 0.54-0.55;
+// what cross does to swd is measured on the shared exemplars, docs/quality.md, "Plane-wise
+// matching from the edge neighbours only").
 TEST(SynthesizerQuality, PlaneWiseFinestMatchContinuesPatchesInEveryPlane) {
   const auto table = small_table(ProceduralKind::kPebbles, false);
   const ImageF& e = table->exemplars().plane(Plane::kXY);

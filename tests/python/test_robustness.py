@@ -197,9 +197,9 @@ def test_finest_match_takes_its_three_names_only(srv):
 
 
 def test_finest_sources_takes_its_two_names_only(srv):
-    # cross (the default, pinned when absent) and square synthesize and differ: auto
+    # square (the default, pinned when absent) and cross synthesize and differ: auto
     # finest_match is plane-wise on this three-level table, the only matching that reads them
-    cuts = takes_its_values_only(srv, "finest_sources", ("cross", "square"), "cross",
+    cuts = takes_its_values_only(srv, "finest_sources", ("square", "cross"), "square",
                                  ("Cross", "diagonal", "", 0, None, ["cross"], {"sources": "cross"}))
     assert cuts["cross"] != cuts["square"]
 

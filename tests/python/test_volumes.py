@@ -326,7 +326,7 @@ def test_old_scheme_name_is_rejected_and_plain_works(shared, tmp_path):
     # finest match and finest sources defaults are pinned
     assert shared.volume["params"] == {"typicality": "auto", "passes": 1, "init": "auto", "color": "auto", "finest_subpass_size": 1,
                                        "balance": 1.0, "finest_typicality_scale": 0.7, "init_band": 8,
-                                       "finest_match": "auto", "finest_sources": "cross"}, shared.volume
+                                       "finest_match": "auto", "finest_sources": "square"}, shared.volume
     default = c.slice(shared.volume_id, "z", 3, (32, 24))
     assert not np.array_equal(png_pixels(png), default), "plain and dual-grid gave the same slice"
     c.delete_volume(vol["id"])
