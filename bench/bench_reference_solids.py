@@ -43,7 +43,9 @@ ones with the layouts `--grain auto` gives them.
 from __future__ import annotations
 
 import argparse
+import functools
 import json
+import re
 import sys
 import tempfile
 from pathlib import Path
@@ -78,8 +80,7 @@ def laid_map(grain: str, across_of, shift_of=None):
 
 def solid_maps(grain: str) -> dict:
     """Solid name -> f(x, y, z) -> (exemplar column, exemplar row), for a layout of `grain`."""
-    def laid(across_of):
-        return laid_map(grain, across_of)
+    laid = functools.partial(laid_map, grain)
     return {
         "extruded": laid(lambda across, z: across),
         "sheets+45": laid(lambda across, z: across + z),
@@ -174,7 +175,7 @@ def main() -> int:
             maps = tilted_maps(grain, [float(v) for v in args.sweep_values.split(",")]) if args.sweep else solid_maps(grain)
             for solid_name, solid in maps.items():
                 cuts = score_solid(sys.executable, exemplar, solid, references, args.size, tmp,
-                                   f"{path.stem}_{solid_name.replace('/', '_').replace(' ', '_').replace(',', '_')}")
+                                   f"{path.stem}_{re.sub(r'[/ ,]', '_', solid_name)}")
                 worst = max(c["swd"] for c in cuts.values())
                 entry["solids"][solid_name] = {
                     "cuts": cuts,
